@@ -1,0 +1,127 @@
+use std::path::PathBuf;
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use glam::Vec3;
+
+use lumiere::integrators::Mode;
+
+#[derive(Parser, Debug)]
+#[command(name = "lumiere", version, about = "A CPU Monte Carlo ray tracer", propagate_version = true)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Render a scene (gKit's Cornell box when no scene is given) to an image.
+    Render(RenderArgs),
+    /// Print a scene's triangles, materials, lights, bounds and load time.
+    Info(InfoArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct InfoArgs {
+    /// Wavefront OBJ file (.obj or .obj.gz) with its MTL files.
+    pub scene: PathBuf,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ModeArg {
+    /// White where a camera ray hits a triangle, black elsewhere.
+    Hits,
+    /// Diffuse colour (Kd) of the hit triangle.
+    Materials,
+    /// Hard shadows: one shadow ray to each light triangle's centroid.
+    Shadows,
+}
+
+impl From<ModeArg> for Mode {
+    fn from(m: ModeArg) -> Mode {
+        match m {
+            ModeArg::Hits => Mode::Hits,
+            ModeArg::Materials => Mode::Materials,
+            ModeArg::Shadows => Mode::Shadows,
+        }
+    }
+}
+
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// Wavefront OBJ file (.obj or .obj.gz); the built-in gKit Cornell box when omitted.
+    pub scene: Option<PathBuf>,
+
+    /// What to compute per pixel.
+    #[arg(long, value_enum, default_value_t = ModeArg::Shadows)]
+    pub mode: ModeArg,
+
+    /// Samples per light triangle or per hemisphere, for the Monte Carlo modes.
+    #[arg(long, default_value_t = 1)]
+    pub samples: u32,
+
+    /// Image size, WIDTHxHEIGHT.
+    #[arg(long, value_parser = parse_size, default_value = "1024x768")]
+    pub size: (u32, u32),
+
+    /// gKit orbiter camera file (c, p, r, s, optional f lines); the built-in scene uses gKit's 2022 one.
+    #[arg(long, conflicts_with_all = ["eye", "target"])]
+    pub orbiter: Option<PathBuf>,
+
+    /// Look-at camera position, x,y,z (needs --target). Without a camera, the view frames the scene.
+    #[arg(long, value_parser = parse_vec3, requires = "target", allow_hyphen_values = true)]
+    pub eye: Option<Vec3>,
+
+    /// Look-at camera target, x,y,z.
+    #[arg(long, value_parser = parse_vec3, requires = "eye", allow_hyphen_values = true)]
+    pub target: Option<Vec3>,
+
+    /// Look-at camera up direction, x,y,z.
+    #[arg(long, value_parser = parse_vec3, default_value = "0,1,0", allow_hyphen_values = true)]
+    pub up: Vec3,
+
+    /// Vertical field of view of the look-at camera, degrees.
+    #[arg(long, default_value_t = 45.0)]
+    pub fov: f32,
+
+    /// Worker threads; 0 = one per core, 1 = serial.
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+
+    /// Seed of the random numbers; the same seed gives the same image bytes for any thread count.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+
+    /// Output image: .png (8-bit sRGB), .exr or .pfm (linear float).
+    #[arg(short, long, default_value = "render.png")]
+    pub output: PathBuf,
+
+    /// Write PNGs as gKit does (floor(255*c), no gamma) for side-by-side comparison with gKit renders.
+    #[arg(long)]
+    pub png_linear: bool,
+
+    /// Write render statistics (mode, size, rays, timings) as JSON to this file.
+    #[arg(long)]
+    pub stats_json: Option<PathBuf>,
+}
+
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("expected WIDTHxHEIGHT, got '{s}'"))?;
+    let parse = |v: &str| v.trim().parse::<u32>().map_err(|_| format!("'{v}' is not a positive integer"));
+    let (w, h) = (parse(w)?, parse(h)?);
+    if w == 0 || h == 0 {
+        return Err(format!("image size {w}x{h} has no pixels"));
+    }
+    Ok((w, h))
+}
+
+fn parse_vec3(s: &str) -> Result<Vec3, String> {
+    let values: Vec<f32> = s
+        .split(',')
+        .map(|v| v.trim().parse::<f32>().ok().filter(|f| f.is_finite()))
+        .collect::<Option<_>>()
+        .ok_or_else(|| format!("expected three finite numbers x,y,z, got '{s}'"))?;
+    match values[..] {
+        [x, y, z] => Ok(Vec3::new(x, y, z)),
+        _ => Err(format!("expected three numbers x,y,z, got '{s}'")),
+    }
+}

@@ -1,0 +1,17 @@
+//! Command-line interface: argument definitions and the subcommands.
+
+mod args;
+mod info;
+mod render;
+
+use lumiere::Result;
+
+pub use args::Cli;
+use args::Command;
+
+pub fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Render(args) => render::run(&args),
+        Command::Info(args) => info::run(&args),
+    }
+}

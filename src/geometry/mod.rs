@@ -1,0 +1,3 @@
+//! Ray/primitive intersection.
+
+pub mod triangle;

@@ -1,0 +1,253 @@
+//! Image files out: sRGB PNG, linear EXR and PFM, always written atomically.
+//!
+//! Every writer encodes the whole file in memory first and hands the bytes to [`write_atomically`], so
+//! a crash, a full disk or a killed process never leaves a half-written image where a previous good
+//! one used to be: readers see either the old file or the complete new one.
+
+use std::fs::{self, File, OpenOptions};
+use std::io::{Cursor, Write};
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use glam::Vec3;
+use image::{ExtendedColorType, ImageEncoder};
+
+use crate::error::{Error, Result};
+
+/// How a PNG stores linear radiance.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum PngEncoding {
+    /// sRGB transfer curve, rounded to nearest 8-bit value (the default for viewing).
+    #[default]
+    Srgb,
+    /// gKit's convention: floor(255 * clamp(c, 0, 1)), no gamma, for side-by-side comparisons with gKit renders.
+    GkitLinear,
+}
+
+/// The file formats we write, chosen by extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Format {
+    Png,
+    Exr,
+    Pfm,
+}
+
+/// Named in the error for an unsupported extension, so the user sees the choices.
+const SUPPORTED: &str = ".png, .exr, .pfm";
+
+/// Writes `pixels` (linear RGB, `width * height`, row 0 = top of the picture) to `path`, choosing the
+/// format from the extension (case-insensitive): `.png` (8-bit, `png` encoding), `.exr` (linear 32-bit
+/// float RGB), `.pfm` (linear float, Portable Float Map). Any other extension -> Error::invalid naming the
+/// supported ones. The file appears atomically: bytes go to a temporary file in the same directory, which
+/// is renamed over `path` only after a complete write (and fsync of the file); on any failure the temporary
+/// file is removed and `path` is untouched.
+pub fn write_image(path: &Path, width: u32, height: u32, pixels: &[Vec3], png: PngEncoding) -> Result<()> {
+    let format = format_of(path)?;
+    check_dimensions(width, height, pixels.len())?;
+    let bytes = match format {
+        Format::Png => encode_png(path, width, height, pixels, png)?,
+        Format::Exr => encode_exr(path, width, height, pixels)?,
+        Format::Pfm => encode_pfm(width, height, pixels),
+    };
+    write_atomically(path, &bytes)
+}
+
+/// Writes arbitrary bytes atomically (same temp-then-rename rule); used by write_image and by other
+/// writers (stats JSON, checkpoints).
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
+    let temp = temp_path(path)?;
+    // Created separately so that a failure here (missing directory, no permission) leaves nothing to
+    // clean up, and so we never remove a file we did not create.
+    let file = create_new(&temp).map_err(|e| Error::io(path, e))?;
+    fill_and_rename(file, &temp, path, bytes).map_err(|e| {
+        // Best effort: the error worth reporting is the one that made us give up.
+        let _ = fs::remove_file(&temp);
+        Error::io(path, e)
+    })
+}
+
+/// Checks before a long render that `path` has a supported extension and its directory exists and is writable
+/// (create and delete a probe temp file), so a render does not run for minutes and then fail.
+pub fn check_output_path(path: &Path) -> Result<()> {
+    format_of(path)?;
+    check_writable(path)
+}
+
+/// Checks that a file can be created at `path` (any extension) without touching `path` itself.
+pub fn check_writable(path: &Path) -> Result<()> {
+    if path.is_dir() {
+        return Err(Error::invalid(format!("{}: is a directory, expected a file name", path.display())));
+    }
+    let probe = temp_path(path)?;
+    create_new(&probe).map_err(|e| Error::io(path, e))?;
+    fs::remove_file(&probe).map_err(|e| Error::io(&probe, e))
+}
+
+/// sRGB encoding of one linear channel to 8 bits (IEC 61966-2-1), clamped; NaN -> 0.
+///
+/// Exact (identical to rounding the f64 formula), at the cost of one table lookup and one comparison:
+/// a 4096-bucket table gives the code at each bucket's lower edge, and since the curve's steepest slope
+/// (12.92 * 255 codes per unit) crosses less than one code per bucket, at most one threshold can lie
+/// inside a bucket, which the comparison resolves.
+pub fn linear_to_srgb8(c: f32) -> u8 {
+    if c.is_nan() || c <= 0.0 {
+        return 0;
+    }
+    if c >= 1.0 {
+        return 255;
+    }
+    let table = srgb_table();
+    // c < 1, so c * 4096 < 4096 exactly (the product of an f32 below 1 and a power of two is exact).
+    let code = table.bucket_code[(c * SRGB_BUCKETS as f32) as usize];
+    code + u8::from(c >= table.threshold[usize::from(code)])
+}
+
+/// Number of buckets over [0, 1); must stay above 12.92 * 255 ≈ 3295 for one comparison to suffice.
+const SRGB_BUCKETS: usize = 4096;
+
+/// Precomputed data for [`linear_to_srgb8`].
+struct SrgbTable {
+    /// `threshold[k]`: the smallest f32 that encodes to code k + 1; `threshold[255]` is +inf.
+    threshold: [f32; 256],
+    /// The code of each bucket's lower edge `i / SRGB_BUCKETS`.
+    bucket_code: [u8; SRGB_BUCKETS],
+}
+
+/// Built once on first use; 5 KB, shared by all threads.
+fn srgb_table() -> &'static SrgbTable {
+    static TABLE: OnceLock<SrgbTable> = OnceLock::new();
+    TABLE.get_or_init(|| {
+        let mut threshold = [f32::INFINITY; 256];
+        for (k, t) in threshold.iter_mut().take(255).enumerate() {
+            *t = srgb_threshold(k as u8 + 1);
+        }
+        let mut bucket_code = [0u8; SRGB_BUCKETS];
+        for (i, code) in bucket_code.iter_mut().enumerate() {
+            let edge = i as f32 / SRGB_BUCKETS as f32;
+            *code = threshold.partition_point(|&t| t <= edge) as u8;
+        }
+        SrgbTable { threshold, bucket_code }
+    })
+}
+
+/// The smallest f32 whose exact sRGB value rounds to at least `code` (i.e. reaches `code - 0.5`).
+///
+/// Starts from the inverse curve in f64, then nudges by single ulps so that the table agrees with the
+/// forward formula even where the f64 -> f32 rounding of the inverse lands on the wrong side.
+fn srgb_threshold(code: u8) -> f32 {
+    let target = (f64::from(code) - 0.5) / 255.0;
+    let mut t = srgb_to_linear_f64(target) as f32;
+    while srgb_f64(f64::from(t)) < target {
+        t = t.next_up();
+    }
+    while srgb_f64(f64::from(t.next_down())) >= target {
+        t = t.next_down();
+    }
+    t
+}
+
+/// The IEC 61966-2-1 forward curve, in f64 so that the table is exact.
+fn srgb_f64(c: f64) -> f64 {
+    if c <= 0.0031308 { 12.92 * c } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 }
+}
+
+/// Inverse of [`srgb_f64`]; only seeds the threshold search.
+fn srgb_to_linear_f64(v: f64) -> f64 {
+    if v <= 0.04045 { v / 12.92 } else { ((v + 0.055) / 1.055).powf(2.4) }
+}
+
+/// gKit's 8-bit convention; NaN -> 0 and +inf -> 255 like the sRGB path.
+fn gkit_linear8(c: f32) -> u8 {
+    if c.is_nan() { 0 } else { (255.0 * c.clamp(0.0, 1.0)) as u8 }
+}
+
+/// Picks the format from the extension, case-insensitively.
+fn format_of(path: &Path) -> Result<Format> {
+    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("png") => Ok(Format::Png),
+        Some("exr") => Ok(Format::Exr),
+        Some("pfm") => Ok(Format::Pfm),
+        _ => Err(Error::invalid(format!("{}: unsupported image extension (supported: {SUPPORTED})", path.display()))),
+    }
+}
+
+/// Refuses empty images and buffers that do not match the stated size, before anything is encoded.
+fn check_dimensions(width: u32, height: u32, len: usize) -> Result<()> {
+    if width == 0 || height == 0 {
+        return Err(Error::invalid(format!("image size {width}x{height} has a zero dimension")));
+    }
+    let expected = (width as usize).checked_mul(height as usize);
+    if expected != Some(len) {
+        return Err(Error::invalid(format!("image is {width}x{height} but {len} pixels were given")));
+    }
+    Ok(())
+}
+
+fn encode_png(path: &Path, width: u32, height: u32, pixels: &[Vec3], encoding: PngEncoding) -> Result<Vec<u8>> {
+    let encode: fn(f32) -> u8 = match encoding {
+        PngEncoding::Srgb => linear_to_srgb8,
+        PngEncoding::GkitLinear => gkit_linear8,
+    };
+    let raw: Vec<u8> = pixels.iter().flat_map(|p| p.to_array().map(encode)).collect();
+    let mut bytes = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut bytes)
+        .write_image(&raw, width, height, ExtendedColorType::Rgb8)
+        .map_err(|e| Error::invalid(format!("{}: cannot encode PNG: {e}", path.display())))?;
+    Ok(bytes)
+}
+
+/// 32-bit float RGB with the exr crate's default lossless compression, so values survive bit for bit.
+fn encode_exr(path: &Path, width: u32, height: u32, pixels: &[Vec3]) -> Result<Vec<u8>> {
+    use exr::prelude::{Image, SpecificChannels, Vec2, WritableImage};
+    let w = width as usize;
+    let channels = SpecificChannels::rgb(|pos: Vec2<usize>| {
+        let p = pixels[pos.y() * w + pos.x()];
+        (p.x, p.y, p.z)
+    });
+    let mut cursor = Cursor::new(Vec::new());
+    Image::from_channels((w, height as usize), channels)
+        .write()
+        .to_buffered(&mut cursor)
+        .map_err(|e| Error::invalid(format!("{}: cannot encode EXR: {e}", path.display())))?;
+    Ok(cursor.into_inner())
+}
+
+/// Portable Float Map: a negative scale means little-endian, and scanlines run bottom to top.
+fn encode_pfm(width: u32, height: u32, pixels: &[Vec3]) -> Vec<u8> {
+    let header = format!("PF\n{width} {height}\n-1.0\n");
+    let mut bytes = Vec::with_capacity(header.len() + pixels.len() * 12);
+    bytes.extend_from_slice(header.as_bytes());
+    for row in pixels.chunks_exact(width as usize).rev() {
+        for value in row.iter().flat_map(|p| p.to_array()) {
+            bytes.extend_from_slice(&value.to_le_bytes());
+        }
+    }
+    bytes
+}
+
+/// `.{file_name}.tmp{pid}-{n}` next to `path`: the same directory keeps the final rename atomic (no
+/// cross-device copy), the pid separates processes and the counter separates threads of this one.
+fn temp_path(path: &Path) -> Result<PathBuf> {
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let name =
+        path.file_name().ok_or_else(|| Error::invalid(format!("{}: output path has no file name", path.display())))?;
+    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+    let temp_name = format!(".{}.tmp{}-{n}", name.to_string_lossy(), std::process::id());
+    Ok(path.with_file_name(temp_name))
+}
+
+/// `create_new` so that a stale file with the same name (a pid reused after a crash) is never clobbered.
+fn create_new(path: &Path) -> std::io::Result<File> {
+    OpenOptions::new().write(true).create_new(true).open(path)
+}
+
+/// Writes and fsyncs before renaming, so that the rename cannot publish a file whose data is still only
+/// in the page cache; the handle is closed before the rename, which Windows requires.
+fn fill_and_rename(mut file: File, temp: &Path, path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    file.write_all(bytes)?;
+    file.sync_all()?;
+    drop(file);
+    fs::rename(temp, path)
+}

@@ -1,0 +1,15 @@
+use glam::Vec3;
+
+use super::{Integrator, SampleContext};
+use crate::math::Ray;
+use crate::world::World;
+
+/// The diffuse colour of the first surface hit.
+pub struct Materials;
+
+impl Integrator for Materials {
+    fn radiance(&self, world: &World, ray: &Ray, ctx: &mut SampleContext) -> Vec3 {
+        ctx.rays += 1;
+        world.intersect(ray).map_or(Vec3::ZERO, |hit| world.scene.material(hit.triangle).kd)
+    }
+}

@@ -1,0 +1,45 @@
+use std::f32::consts::FRAC_1_PI;
+
+use glam::Vec3;
+
+use super::{Integrator, SampleContext};
+use crate::math::{Ray, offset_ray_origin};
+use crate::world::World;
+
+/// The lab's hard shadows: every light triangle acts as a point light at its centroid carrying the
+/// triangle's area, `L = sum Ke * Kd/pi * cos(theta) * cos(theta_light) * area / d^2 * V`.
+pub struct Shadows;
+
+impl Integrator for Shadows {
+    fn radiance(&self, world: &World, ray: &Ray, ctx: &mut SampleContext) -> Vec3 {
+        ctx.rays += 1;
+        let Some(hit) = world.intersect(ray) else { return Vec3::ZERO };
+        let surface = world.surface(ray, &hit);
+        let material = world.scene.material(hit.triangle);
+        if material.is_emissive() {
+            return material.ke;
+        }
+        let origin = offset_ray_origin(surface.p, surface.ng);
+        let mut sum = Vec3::ZERO;
+        for light in &world.scene.lights {
+            let centroid = light.centroid();
+            let to_light = centroid - surface.p;
+            let d2 = to_light.length_squared();
+            let wi = to_light / d2.sqrt();
+            let cos_surface = surface.ns.dot(wi);
+            let cos_light = light.normal.dot(-wi);
+            if cos_surface <= 0.0 || cos_light <= 0.0 || surface.ng.dot(wi) <= 0.0 {
+                continue;
+            }
+            // The segment ends just in front of the light, so it neither stops short of the light nor
+            // reports the light itself as the occluder.
+            let target = offset_ray_origin(centroid, light.normal);
+            ctx.rays += 1;
+            if world.occluded(&Ray::segment(origin, target)) {
+                continue;
+            }
+            sum += light.emission * cos_surface * cos_light * light.area / d2;
+        }
+        sum * material.kd * FRAC_1_PI
+    }
+}

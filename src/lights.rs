@@ -1,0 +1,53 @@
+//! Emissive triangles as area lights.
+
+use glam::Vec3;
+
+use crate::geometry::triangle::{triangle_area, triangle_normal};
+use crate::scene::material::Material;
+use crate::scene::mesh::TriangleMesh;
+
+/// One emissive triangle. It emits `emission` (radiance) from the side its unit `normal` points to
+/// (the winding `p0 -> p1 -> p2`), as gKit's and McGuire's boxes orient their lights.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AreaLight {
+    pub triangle: u32,
+    pub vertices: [Vec3; 3],
+    pub normal: Vec3,
+    pub area: f32,
+    pub emission: Vec3,
+}
+
+impl AreaLight {
+    pub fn centroid(&self) -> Vec3 {
+        (self.vertices[0] + self.vertices[1] + self.vertices[2]) / 3.0
+    }
+
+    /// Radiant flux of a Lambertian emitter: `pi * L * A` per channel.
+    pub fn power(&self) -> Vec3 {
+        std::f32::consts::PI * self.area * self.emission
+    }
+
+    /// Radiance leaving the light towards direction `w` (pointing away from the light).
+    #[inline]
+    pub fn radiance_towards(&self, w: Vec3) -> Vec3 {
+        if self.normal.dot(w) > 0.0 { self.emission } else { Vec3::ZERO }
+    }
+}
+
+/// Every emissive triangle of a mesh, in triangle id order. Zero-area triangles are skipped: they
+/// emit nothing and have no normal.
+pub fn collect_lights(mesh: &TriangleMesh, materials: &[Material]) -> Vec<AreaLight> {
+    (0..mesh.triangle_count())
+        .filter_map(|id| {
+            let emission = materials[mesh.material_ids[id] as usize].ke;
+            if emission.max_element() <= 0.0 {
+                return None;
+            }
+            let vertices = mesh.vertices(id);
+            let [p0, p1, p2] = vertices;
+            let area = triangle_area(p0, p1, p2);
+            let normal = triangle_normal(p0, p1, p2).try_normalize()?;
+            (area > 0.0).then_some(AreaLight { triangle: id as u32, vertices, normal, area, emission })
+        })
+        .collect()
+}

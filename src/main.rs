@@ -1,0 +1,16 @@
+//! The `lumiere` command: arguments in, image and statistics out. All rendering lives in the library.
+
+mod cli;
+
+use std::process::ExitCode;
+
+fn main() -> ExitCode {
+    let args = <cli::Cli as clap::Parser>::parse();
+    match cli::run(args) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("lumiere: error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}

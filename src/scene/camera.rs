@@ -1,0 +1,199 @@
+//! Cameras: gKit's orbiter (reproduced matrix for matrix, so images line up with the lab's) and a
+//! look-at pinhole.
+//!
+//! Both generate rays from continuous film coordinates `(x, y)` with `(0, 0)` the top-left corner
+//! of the picture and `(w, h)` the bottom-right one; the pixel `(i, j)` is the square
+//! `[i, i+1] x [j, j+1]`, its centre `(i + 0.5, j + 0.5)`.
+
+use std::path::Path;
+
+use glam::{DMat4, DVec2, DVec3, DVec4, Vec3};
+
+use crate::error::{Error, Result};
+use crate::math::Ray;
+
+/// gKit's `Orbiter` state as stored in its text files (`c`, `p`, `r`, `s`, optional `f` lines).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Orbiter {
+    pub center: DVec3,
+    pub pan: DVec2,
+    /// Rotations about x then y, degrees.
+    pub rotation: DVec2,
+    pub size: f64,
+    pub radius: f64,
+    /// `f fov width height`, informative only: the lab overrides it with `projection(w, h, 45)`.
+    pub frame: Option<(f64, f64, f64)>,
+}
+
+impl Orbiter {
+    pub fn load(path: &Path) -> Result<Orbiter> {
+        let text = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+        Orbiter::parse(&text, path)
+    }
+
+    /// Parses orbiter text; `path` names the file in errors.
+    pub fn parse(bytes: &[u8], path: &Path) -> Result<Orbiter> {
+        let mut fields: [Option<Vec<f64>>; 5] = Default::default();
+        for (index, raw) in bytes.split(|&b| b == b'\n').enumerate() {
+            let line = index + 1;
+            let text = std::str::from_utf8(raw).map_err(|_| Error::parse(path, line, "not UTF-8 text"))?;
+            let mut tokens = text.split_whitespace();
+            let Some(key) = tokens.next() else { continue };
+            let (slot, arity) = match key {
+                "c" => (0, 3),
+                "p" => (1, 2),
+                "r" => (2, 2),
+                "s" => (3, 2),
+                "f" => (4, 3),
+                _ if key.starts_with('#') => continue,
+                _ => {
+                    return Err(Error::parse(
+                        path,
+                        line,
+                        format!("unknown orbiter field '{key}' (expected c, p, r, s or f)"),
+                    ));
+                }
+            };
+            let values = tokens
+                .map(|t| t.parse::<f64>().ok().filter(|v| v.is_finite()).ok_or(t))
+                .collect::<std::result::Result<Vec<f64>, &str>>()
+                .map_err(|t| Error::parse(path, line, format!("'{key}' expects finite numbers, found '{t}'")))?;
+            if values.len() != arity {
+                return Err(Error::parse(
+                    path,
+                    line,
+                    format!("'{key}' expects {arity} numbers, found {}", values.len()),
+                ));
+            }
+            fields[slot] = Some(values);
+        }
+        let total_lines = bytes.split(|&b| b == b'\n').count();
+        let mut take = |slot: usize, key: &str| {
+            fields[slot].take().ok_or_else(|| Error::parse(path, total_lines, format!("missing '{key}' line")))
+        };
+        let (c, p, r, s) = (take(0, "c")?, take(1, "p")?, take(2, "r")?, take(3, "s")?);
+        let frame = fields[4].take().map(|f| (f[0], f[1], f[2]));
+        Ok(Orbiter {
+            center: DVec3::new(c[0], c[1], c[2]),
+            pan: DVec2::new(p[0], p[1]),
+            rotation: DVec2::new(r[0], r[1]),
+            size: s[0],
+            radius: s[1],
+            frame,
+        })
+    }
+
+    /// gKit's `Orbiter::view()`.
+    pub fn view(&self) -> DMat4 {
+        DMat4::from_translation(DVec3::new(-self.pan.x, -self.pan.y, -self.size))
+            * DMat4::from_rotation_x(self.rotation.x.to_radians())
+            * DMat4::from_rotation_y(self.rotation.y.to_radians())
+            * DMat4::from_translation(-self.center)
+    }
+
+    /// gKit's `Orbiter::projection(width, height, fov)`, near/far planes computed as gKit does.
+    pub fn projection(&self, width: f64, height: f64, fov_degrees: f64) -> DMat4 {
+        let d = self.center.distance(DVec3::new(self.pan.x, self.pan.y, self.size));
+        let znear = (d - self.radius).max(0.1);
+        let zfar = (d + self.radius).max(1.0);
+        gl_perspective(fov_degrees, width / height, znear, zfar)
+    }
+}
+
+/// OpenGL's perspective matrix, as gKit's `Perspective()` builds it.
+fn gl_perspective(fov_degrees: f64, aspect: f64, znear: f64, zfar: f64) -> DMat4 {
+    let itan = 1.0 / (fov_degrees.to_radians() / 2.0).tan();
+    let id = 1.0 / (znear - zfar);
+    DMat4::from_cols(
+        DVec4::new(itan / aspect, 0.0, 0.0, 0.0),
+        DVec4::new(0.0, itan, 0.0, 0.0),
+        DVec4::new(0.0, 0.0, (zfar + znear) * id, -1.0),
+        DVec4::new(0.0, 0.0, 2.0 * zfar * znear * id, 0.0),
+    )
+}
+
+/// gKit's `Viewport(width, height)`: NDC to pixel coordinates, depth to [0, 1].
+fn gl_viewport(width: f64, height: f64) -> DMat4 {
+    DMat4::from_cols(
+        DVec4::new(width / 2.0, 0.0, 0.0, 0.0),
+        DVec4::new(0.0, height / 2.0, 0.0, 0.0),
+        DVec4::new(0.0, 0.0, 0.5, 0.0),
+        DVec4::new(width / 2.0, height / 2.0, 0.5, 1.0),
+    )
+}
+
+#[derive(Clone, Debug, PartialEq)]
+enum Projection {
+    /// Image space to world: `inverse(viewport * projection * view)`, gKit's `y = 0` at the bottom.
+    ImageToWorld(DMat4),
+    /// Pinhole at `eye`; `right`/`up` are scaled so that film corners map to `forward ± right ± up`.
+    Pinhole { eye: Vec3, forward: Vec3, right: Vec3, up: Vec3 },
+}
+
+/// A camera producing one ray per film position.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Camera {
+    pub width: u32,
+    pub height: u32,
+    projection: Projection,
+}
+
+impl Camera {
+    /// gKit's camera for the lab: `orbiter.projection(width, height, 45)`.
+    pub fn from_orbiter(orbiter: &Orbiter, width: u32, height: u32) -> Camera {
+        let (w, h) = (width as f64, height as f64);
+        let m = gl_viewport(w, h) * orbiter.projection(w, h, 45.0) * orbiter.view();
+        Camera { width, height, projection: Projection::ImageToWorld(m.inverse()) }
+    }
+
+    /// A pinhole at `eye` looking at `target`, with vertical field of view `fov_degrees`.
+    pub fn look_at(eye: Vec3, target: Vec3, up: Vec3, fov_degrees: f32, width: u32, height: u32) -> Result<Camera> {
+        let forward = (target - eye)
+            .try_normalize()
+            .ok_or_else(|| Error::invalid("camera: --eye and --target are the same point"))?;
+        let right = forward
+            .cross(up)
+            .try_normalize()
+            .ok_or_else(|| Error::invalid("camera: --up is zero or parallel to the viewing direction"))?;
+        if !(fov_degrees > 0.0 && fov_degrees < 180.0) {
+            return Err(Error::invalid(format!("camera: --fov must be in (0, 180) degrees, got {fov_degrees}")));
+        }
+        let half_height = (fov_degrees.to_radians() / 2.0).tan();
+        let half_width = half_height * width as f32 / height as f32;
+        let true_up = right.cross(forward);
+        Ok(Camera {
+            width,
+            height,
+            projection: Projection::Pinhole { eye, forward, right: right * half_width, up: true_up * half_height },
+        })
+    }
+
+    /// The ray through film position `(x, y)` (top-left origin), with a unit direction.
+    pub fn ray(&self, x: f32, y: f32) -> Ray {
+        match &self.projection {
+            Projection::ImageToWorld(inv) => {
+                let (origin, extremity) = image_to_world(inv, x as f64, self.height as f64 - y as f64);
+                Ray::new(origin.as_vec3(), (extremity - origin).normalize().as_vec3())
+            }
+            Projection::Pinhole { eye, forward, right, up } => {
+                let sx = 2.0 * x / self.width as f32 - 1.0;
+                let sy = 1.0 - 2.0 * y / self.height as f32;
+                Ray::new(*eye, (*forward + sx * *right + sy * *up).normalize())
+            }
+        }
+    }
+
+    /// For gKit cameras, the lab's ray endpoints for image position `(x, y)` with `y = 0` at the
+    /// bottom: `inv(x, y, 0)` on the near plane and `inv(x, y, 1)` on the far plane. `None` for pinholes.
+    pub fn gkit_ray_endpoints(&self, x: f64, y: f64) -> Option<(DVec3, DVec3)> {
+        match &self.projection {
+            Projection::ImageToWorld(inv) => Some(image_to_world(inv, x, y)),
+            Projection::Pinhole { .. } => None,
+        }
+    }
+}
+
+/// Maps image position `(x, y)` at depths 0 and 1 back to world space (with the divide by w).
+fn image_to_world(inv: &DMat4, x: f64, y: f64) -> (DVec3, DVec3) {
+    (inv.project_point3(DVec3::new(x, y, 0.0)), inv.project_point3(DVec3::new(x, y, 1.0)))
+}

@@ -1,0 +1,89 @@
+//! Byte-level helpers shared by the OBJ and MTL parsers: lines, whitespace tokens, numbers.
+//!
+//! Both parsers read raw bytes, not `&str`: validating UTF-8 up front would cost a pass over 45 MB
+//! files and would reject old files whose comments are Latin-1. Only the tokens that must be text
+//! (numbers, names) are converted, each on its own, so a stray byte never aborts a whole file.
+
+use std::borrow::Cow;
+
+/// The lines of `bytes`, split at `\n`. A CRLF line keeps its `\r`, which the tokenizer treats as
+/// whitespace. There is always exactly one more piece than there are `\n` bytes.
+pub(super) fn lines(bytes: &[u8]) -> impl Iterator<Item = &[u8]> {
+    bytes.split(|&b| b == b'\n')
+}
+
+/// Whitespace-separated tokens of one line, without allocating. A token that starts with `#` ends
+/// the line: MTL files in the wild put comments after values (`Ka 0.7 0.7 0.7 # White`), while a
+/// `#` inside a token (`Material#1`) is kept.
+pub(super) struct Tokens<'a> {
+    rest: &'a [u8],
+}
+
+impl<'a> Tokens<'a> {
+    pub(super) fn new(line: &'a [u8]) -> Self {
+        Tokens { rest: line }
+    }
+
+    /// What is left of the line, trimmed, as one name: material and file names may contain spaces.
+    pub(super) fn remainder(self) -> Cow<'a, str> {
+        let rest = self.rest.trim_ascii_start();
+        let comment = rest
+            .iter()
+            .enumerate()
+            .position(|(i, &b)| b == b'#' && (i == 0 || rest[i - 1].is_ascii_whitespace()))
+            .unwrap_or(rest.len());
+        String::from_utf8_lossy(rest[..comment].trim_ascii_end())
+    }
+}
+
+impl<'a> Iterator for Tokens<'a> {
+    type Item = &'a [u8];
+
+    fn next(&mut self) -> Option<&'a [u8]> {
+        let rest = self.rest.trim_ascii_start();
+        if rest.first().is_none_or(|&b| b == b'#') {
+            self.rest = &[];
+            return None;
+        }
+        let end = rest.iter().position(u8::is_ascii_whitespace).unwrap_or(rest.len());
+        let (token, rest) = rest.split_at(end);
+        self.rest = rest;
+        Some(token)
+    }
+}
+
+/// A token quoted for an error message, readable even when it is not UTF-8.
+pub(super) fn quoted(token: &[u8]) -> String {
+    format!("{:?}", String::from_utf8_lossy(token))
+}
+
+/// Parses a finite `f32`. NaN and infinities are refused: they would poison the BVH bounds.
+pub(super) fn finite_f32(token: &[u8]) -> Result<f32, String> {
+    let value = std::str::from_utf8(token).ok().and_then(|text| text.parse::<f32>().ok());
+    match value {
+        Some(x) if x.is_finite() => Ok(x),
+        Some(_) => Err(format!("number {} is not finite", quoted(token))),
+        None => Err(format!("malformed number {}", quoted(token))),
+    }
+}
+
+/// Parses a signed decimal integer. Values past the `i64` range saturate instead of failing: an
+/// index that large is out of range anyway, and the caller reports it with the token's own text.
+pub(super) fn saturating_i64(token: &[u8]) -> Option<i64> {
+    let (negative, digits) = match token {
+        [b'-', digits @ ..] => (true, digits),
+        [b'+', digits @ ..] => (false, digits),
+        digits => (false, digits),
+    };
+    if digits.is_empty() {
+        return None;
+    }
+    let mut value: i64 = 0;
+    for &digit in digits {
+        if !digit.is_ascii_digit() {
+            return None;
+        }
+        value = value.saturating_mul(10).saturating_add(i64::from(digit - b'0'));
+    }
+    Some(if negative { -value } else { value })
+}

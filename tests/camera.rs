@@ -1,0 +1,69 @@
+//! gKit's camera reproduced to the published numbers, and the look-at pinhole's conventions.
+
+use std::path::Path;
+
+use glam::{DVec3, Vec3};
+use lumiere::scene::camera::{Camera, Orbiter};
+
+fn orbiter_2022() -> Orbiter {
+    let path = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/cornell/cornell_orbiter.txt"));
+    Orbiter::load(path).expect("the shipped orbiter file parses")
+}
+
+fn assert_close(actual: DVec3, expected: [f64; 3], tolerance: f64) {
+    let expected = DVec3::from_array(expected);
+    assert!((actual - expected).abs().max_element() < tolerance, "got {actual:?}, expected {expected:?}");
+}
+
+#[test]
+fn gkit_2022_pixel_0_0_matches_the_published_endpoints() {
+    let camera = Camera::from_orbiter(&orbiter_2022(), 1024, 768);
+    let (origin, extremity) = camera.gkit_ray_endpoints(0.5, 0.5).expect("an orbiter camera");
+    assert_close(origin, [-0.561618, 1.428429, 2.241525], 2e-6);
+    assert_close(extremity, [-2.434118, -2.905999, -3.579812], 2e-6);
+}
+
+#[test]
+fn film_row_zero_is_gkit_top_row() {
+    let camera = Camera::from_orbiter(&orbiter_2022(), 1024, 768);
+    // Film pixel (0, 767) (bottom-left) is gKit's pixel (0, 0).
+    let ray = camera.ray(0.5, 767.5);
+    let (origin, extremity) = camera.gkit_ray_endpoints(0.5, 0.5).unwrap();
+    assert!((ray.origin.as_dvec3() - origin).length() < 1e-5);
+    let expected_dir = (extremity - origin).normalize();
+    assert!((ray.dir.as_dvec3() - expected_dir).length() < 1e-5);
+}
+
+#[test]
+fn orbiter_parse_reads_all_fields_and_rejects_garbage() {
+    let o = orbiter_2022();
+    assert_eq!(o.rotation.x, 18.0);
+    assert_eq!(o.rotation.y, 16.0);
+    assert_eq!(o.frame, Some((45.0, 1024.0, 640.0)));
+    let path = Path::new("cam.txt");
+    let err = Orbiter::parse(b"c 0 0 0\np 0 zero\n", path).unwrap_err().to_string();
+    assert!(err.contains("cam.txt:2"), "{err}");
+    let err = Orbiter::parse(b"c 0 0 0\np 0 0\nr 0 0\n", path).unwrap_err().to_string();
+    assert!(err.contains("missing 's'"), "{err}");
+    let err = Orbiter::parse(b"c 0 0 nan\n", path).unwrap_err().to_string();
+    assert!(err.contains("cam.txt:1"), "{err}");
+}
+
+#[test]
+fn look_at_centre_ray_points_at_target_and_row_zero_is_up() {
+    let camera = Camera::look_at(Vec3::new(0.0, 1.0, 3.9), Vec3::new(0.0, 1.0, 0.0), Vec3::Y, 45.0, 200, 100).unwrap();
+    let centre = camera.ray(100.0, 50.0);
+    assert!((centre.dir - Vec3::NEG_Z).length() < 1e-6);
+    let top = camera.ray(100.0, 0.0);
+    assert!((top.dir.angle_between(Vec3::NEG_Z).to_degrees() - 22.5).abs() < 1e-3);
+    assert!(top.dir.y > 0.0, "row 0 is the top of the picture");
+    let right = camera.ray(200.0, 50.0);
+    assert!(right.dir.x > 0.0, "the last column is on the right");
+}
+
+#[test]
+fn look_at_rejects_degenerate_frames() {
+    assert!(Camera::look_at(Vec3::ZERO, Vec3::ZERO, Vec3::Y, 45.0, 10, 10).is_err());
+    assert!(Camera::look_at(Vec3::ZERO, Vec3::Y, Vec3::Y, 45.0, 10, 10).is_err());
+    assert!(Camera::look_at(Vec3::ZERO, Vec3::Z, Vec3::Y, 180.0, 10, 10).is_err());
+}
