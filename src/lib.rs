@@ -21,6 +21,7 @@
 //! ```
 
 pub mod accel;
+pub mod bench;
 pub mod error;
 pub mod geometry;
 pub mod image_io;
@@ -28,6 +29,8 @@ pub mod integrators;
 pub mod lights;
 pub mod math;
 pub mod render;
+pub mod sampler;
+pub mod sampling;
 pub mod scene;
 pub mod world;
 

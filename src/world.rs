@@ -2,14 +2,15 @@
 
 use glam::Vec3;
 
-use crate::accel::{BuildPreset, Bvh, Hit};
+use crate::accel::{BuildPreset, Bvh, Bvh4, Hit};
 use crate::math::Ray;
 use crate::scene::Scene;
 use crate::scene::mesh::NO_INDEX;
 
 pub struct World {
     pub scene: Scene,
-    pub bvh: Bvh,
+    /// The 4-wide BVH; the binary tree it was collapsed from is dropped to save memory.
+    pub bvh: Bvh4,
 }
 
 /// What an integrator needs to know about a hit point.
@@ -26,8 +27,8 @@ pub struct SurfacePoint {
 
 impl World {
     pub fn new(scene: Scene, preset: BuildPreset) -> World {
-        let bvh = Bvh::build(&scene.mesh.positions, &scene.mesh.indices, preset);
-        World { scene, bvh }
+        let binary = Bvh::build(&scene.mesh.positions, &scene.mesh.indices, preset);
+        World { scene, bvh: Bvh4::from_binary(&binary) }
     }
 
     #[inline]

@@ -5,7 +5,7 @@ mod common;
 
 use common::{TestRng, grid_cube};
 use glam::Vec3;
-use lumiere::accel::{BuildPreset, Bvh, Hit};
+use lumiere::accel::{BuildPreset, Bvh, Bvh4, Hit, TraversalStats};
 use lumiere::geometry::triangle::{WatertightRay, intersect_triangle, is_degenerate};
 use lumiere::math::Ray;
 
@@ -60,19 +60,27 @@ fn random_mesh(rng: &mut TestRng, kind: usize) -> (Vec<Vec3>, Vec<[u32; 3]>) {
     (positions, indices)
 }
 
+/// Every preset and every traversal path (binary scalar, 4-wide SIMD, counted variants) must give
+/// brute force's answer bit for bit: same triangle, same t and barycentrics, same occlusion.
 fn check_against_brute_force(positions: &[Vec3], indices: &[[u32; 3]], rays: &[Ray], context: &str) {
     for preset in BuildPreset::ALL {
         let bvh = Bvh::build(positions, indices, preset);
         bvh.validate().unwrap_or_else(|e| panic!("{context} {preset:?}: {e}"));
+        let wide = Bvh4::from_binary(&bvh);
+        let mut stats = TraversalStats::default();
         for ray in rays {
             let expected = brute_force(positions, indices, ray);
-            let got = bvh.intersect(ray);
-            assert_eq!(got.map(|h| h.triangle), expected.map(|h| h.triangle), "{context} {preset:?} {ray:?}");
-            if let (Some(g), Some(e)) = (got, expected) {
-                assert_eq!(g.t, e.t, "{context} {preset:?} {ray:?}");
+            let paths = [
+                ("binary", bvh.intersect(ray), bvh.occluded(ray)),
+                ("wide", wide.intersect(ray), wide.occluded(ray)),
+                ("wide counted", wide.intersect_counted(ray, &mut stats), wide.occluded_counted(ray, &mut stats)),
+            ];
+            for (path, hit, occluded) in paths {
+                assert_eq!(hit, expected, "{context} {preset:?} {path} {ray:?}");
+                assert_eq!(occluded, expected.is_some(), "{context} {preset:?} {path} occlusion {ray:?}");
             }
-            assert_eq!(bvh.occluded(ray), expected.is_some(), "{context} {preset:?} occlusion {ray:?}");
         }
+        assert!(rays.is_empty() || indices.is_empty() || stats.nodes > 0, "{context}: counters count");
     }
 }
 
@@ -112,9 +120,10 @@ fn closed_mesh_rays_through_vertices_and_edges_never_leak() {
     rays.extend((0..500).map(|_| Ray::new(origin, rng.direction())));
     for preset in BuildPreset::ALL {
         let bvh = Bvh::build(&positions, &indices, preset);
+        let wide = Bvh4::from_binary(&bvh);
         for ray in &rays {
-            assert!(bvh.intersect(ray).is_some(), "{preset:?}: {ray:?} escaped");
-            assert!(bvh.occluded(ray), "{preset:?}: {ray:?} escaped");
+            assert!(bvh.intersect(ray).is_some() && wide.intersect(ray).is_some(), "{preset:?}: {ray:?} escaped");
+            assert!(bvh.occluded(ray) && wide.occluded(ray), "{preset:?}: {ray:?} escaped");
         }
     }
     check_against_brute_force(&positions, &indices, &rays, "grid cube");

@@ -5,7 +5,8 @@
 //! Large subtrees are built in parallel with rayon and stitched into one array, so siblings stay
 //! adjacent and the layout is the same whatever the thread count.
 
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
+use rayon::prelude::*;
 
 use super::{Bvh, Node};
 use crate::geometry::triangle::is_degenerate;
@@ -53,20 +54,93 @@ impl BuildPreset {
     }
 }
 
-/// Relative cost of visiting a node versus testing one triangle.
+/// Relative cost of visiting a node versus testing one block of four triangles.
 const TRAVERSAL_COST: f64 = 1.0;
 const INTERSECTION_COST: f64 = 1.0;
 
+/// Leaves are tested four triangles at a time (see `wide.rs`), so a leaf of 1 to 4 triangles costs
+/// one block test: counting blocks instead of triangles fills the leaves' SIMD lanes.
+pub(super) fn leaf_cost(count: usize) -> f64 {
+    count.div_ceil(4) as f64
+}
+
+/// Nodes with more triangles than this bin them in parallel chunks (the top levels, where
+/// `rayon::join` has not yet split the work).
+const PARALLEL_BINNING_THRESHOLD: usize = 1 << 16;
+const BINNING_CHUNK: usize = 1 << 14;
+
+/// A box in 16-byte lanes, so that growing it is one SSE min and one max.
+#[derive(Clone, Copy, Debug)]
+struct Box3A {
+    min: Vec3A,
+    max: Vec3A,
+}
+
+impl Box3A {
+    const EMPTY: Box3A = Box3A { min: Vec3A::INFINITY, max: Vec3A::NEG_INFINITY };
+
+    #[inline(always)]
+    fn union(self, o: Box3A) -> Box3A {
+        Box3A { min: self.min.min(o.min), max: self.max.max(o.max) }
+    }
+
+    #[inline(always)]
+    fn grow(self, p: Vec3A) -> Box3A {
+        Box3A { min: self.min.min(p), max: self.max.max(p) }
+    }
+
+    fn to_aabb(self) -> Aabb {
+        Aabb { min: self.min.into(), max: self.max.into() }
+    }
+}
+
+/// Bounds of the triangles of a node and of their centroids, gathered in one pass.
+#[derive(Clone, Copy)]
+struct NodeBounds {
+    bounds: Box3A,
+    centroids: Box3A,
+}
+
+impl NodeBounds {
+    const EMPTY: NodeBounds = NodeBounds { bounds: Box3A::EMPTY, centroids: Box3A::EMPTY };
+
+    fn merge(self, o: NodeBounds) -> NodeBounds {
+        NodeBounds { bounds: self.bounds.union(o.bounds), centroids: self.centroids.union(o.centroids) }
+    }
+}
+
 struct Context<'a> {
-    bounds: &'a [Aabb],
-    centroids: &'a [Vec3],
+    bounds: &'a [Box3A],
+    centroids: &'a [Vec3A],
     bins: usize,
+}
+
+impl Context<'_> {
+    fn node_bounds(&self, order: &[u32]) -> NodeBounds {
+        let gather = |ids: &[u32]| {
+            ids.iter().fold(NodeBounds::EMPTY, |acc, &i| NodeBounds {
+                bounds: acc.bounds.union(self.bounds[i as usize]),
+                centroids: acc.centroids.grow(self.centroids[i as usize]),
+            })
+        };
+        if order.len() > PARALLEL_BINNING_THRESHOLD {
+            order.par_chunks(BINNING_CHUNK).map(gather).reduce(|| NodeBounds::EMPTY, NodeBounds::merge)
+        } else {
+            gather(order)
+        }
+    }
 }
 
 pub fn build(positions: &[Vec3], indices: &[[u32; 3]], preset: BuildPreset) -> Bvh {
     let corners = |t: &[u32; 3]| t.map(|i| positions[i as usize]);
-    let bounds: Vec<Aabb> = indices.iter().map(|t| Aabb::from_points(&corners(t))).collect();
-    let centroids: Vec<Vec3> = bounds.iter().map(Aabb::center).collect();
+    let bounds: Vec<Box3A> = indices
+        .par_iter()
+        .map(|t| {
+            let [a, b, c] = corners(t).map(Vec3A::from);
+            Box3A { min: a.min(b).min(c), max: a.max(b).max(c) }
+        })
+        .collect();
+    let centroids: Vec<Vec3A> = bounds.par_iter().map(|b| 0.5 * (b.min + b.max)).collect();
     // Zero-area triangles have no surface and are never hit (see `is_degenerate`).
     let mut order: Vec<u32> = (0..indices.len() as u32)
         .filter(|&i| {
@@ -93,8 +167,9 @@ fn build_subtree(ctx: &Context, order: &mut [u32], offset: usize, depth: usize) 
 
 /// Fills node `index` of `nodes` for the triangles `order`, appending its descendants.
 fn build_into(ctx: &Context, order: &mut [u32], offset: usize, depth: usize, index: usize, nodes: &mut Vec<Node>) {
-    let bounds = order.iter().fold(Aabb::EMPTY, |b, &i| b.union(ctx.bounds[i as usize]));
-    let Some(mid) = choose_split(ctx, order, &bounds, depth) else {
+    let node_bounds = ctx.node_bounds(order);
+    let bounds = node_bounds.bounds.to_aabb();
+    let Some(mid) = choose_split(ctx, order, &bounds, &node_bounds.centroids.to_aabb(), depth) else {
         nodes[index] = Node::new(bounds, offset as u32, order.len() as u32);
         return;
     };
@@ -138,12 +213,17 @@ fn stitch(nodes: &mut Vec<Node>, first_child: usize, left: Vec<Node>, right: Vec
 }
 
 /// Decides whether to split `order`; if so, partitions it in place and returns the size of the left part.
-fn choose_split(ctx: &Context, order: &mut [u32], bounds: &Aabb, depth: usize) -> Option<usize> {
+fn choose_split(
+    ctx: &Context,
+    order: &mut [u32],
+    bounds: &Aabb,
+    centroid_bounds: &Aabb,
+    depth: usize,
+) -> Option<usize> {
     let count = order.len();
     if count <= 1 {
         return None;
     }
-    let centroid_bounds = order.iter().fold(Aabb::EMPTY, |b, &i| b.grow(ctx.centroids[i as usize]));
     let extent = centroid_bounds.extent();
     let binnable = extent.max_element() > 0.0 && extent.is_finite();
     if depth >= SAH_DEPTH_LIMIT || !binnable {
@@ -152,12 +232,12 @@ fn choose_split(ctx: &Context, order: &mut [u32], bounds: &Aabb, depth: usize) -
         return median_split(ctx, order, if binnable { extent.max_position() } else { 0 });
     }
 
-    let Some(split) = best_binned_split(ctx, order, &centroid_bounds) else {
+    let Some(split) = best_binned_split(ctx, order, centroid_bounds) else {
         return median_split(ctx, order, extent.max_position());
     };
-    let leaf_cost = INTERSECTION_COST * count as f64;
+    let as_leaf = INTERSECTION_COST * leaf_cost(count);
     let split_cost = TRAVERSAL_COST + INTERSECTION_COST * split.cost / bounds.half_area();
-    if count <= MAX_LEAF_SIZE && leaf_cost <= split_cost {
+    if count <= MAX_LEAF_SIZE && as_leaf <= split_cost {
         return None;
     }
     let (axis, min, scale) = (split.axis, centroid_bounds.min[split.axis], split.scale);
@@ -181,56 +261,99 @@ struct Split {
     axis: usize,
     /// Triangles in bins `< bin` go left.
     bin: usize,
-    /// `area_left * count_left + area_right * count_right` (half areas).
+    /// `area_left * leaf_cost(count_left) + area_right * leaf_cost(count_right)` (half areas).
     cost: f64,
     scale: f32,
 }
 
-#[derive(Clone, Copy, Default)]
+#[derive(Clone, Copy)]
 struct Bin {
-    bounds: Aabb,
+    bounds: Box3A,
     count: u32,
+}
+
+impl Bin {
+    const EMPTY: Bin = Bin { bounds: Box3A::EMPTY, count: 0 };
+
+    fn merge(self, o: Bin) -> Bin {
+        Bin { bounds: self.bounds.union(o.bounds), count: self.count + o.count }
+    }
+}
+
+/// One row of `B` bins per axis. `B` is a compile-time constant so that each preset initialises only
+/// the bins it uses (a 64-bin grid is 9 KB, and there is one per node).
+type BinGrid<const B: usize> = [[Bin; B]; 3];
+
+/// Bins the centroids of `order` along the three axes at once.
+fn bin_triangles<const B: usize>(ctx: &Context, order: &[u32], min: Vec3A, scale: Vec3A) -> BinGrid<B> {
+    let last = Vec3A::splat((B - 1) as f32);
+    let mut grid = [[Bin::EMPTY; B]; 3];
+    for &i in order {
+        let b = ctx.bounds[i as usize];
+        // Float min before the integer conversion keeps the index in range (NaN never occurs here).
+        let index = ((ctx.centroids[i as usize] - min) * scale).min(last).to_array();
+        for axis in 0..3 {
+            let bin = &mut grid[axis][index[axis] as usize];
+            bin.bounds = bin.bounds.union(b);
+            bin.count += 1;
+        }
+    }
+    grid
+}
+
+fn merge_grids<const B: usize>(mut a: BinGrid<B>, b: BinGrid<B>) -> BinGrid<B> {
+    for (row_a, row_b) in a.iter_mut().zip(b.iter()) {
+        for (x, y) in row_a.iter_mut().zip(row_b.iter()) {
+            *x = x.merge(*y);
+        }
+    }
+    a
 }
 
 /// The cheapest bin boundary over the three axes, or None if every candidate puts all triangles
 /// on one side (possible only for degenerate centroid layouts).
 fn best_binned_split(ctx: &Context, order: &[u32], centroid_bounds: &Aabb) -> Option<Split> {
-    let bins = ctx.bins;
+    match ctx.bins {
+        8 => best_binned_split_with::<8>(ctx, order, centroid_bounds),
+        16 => best_binned_split_with::<16>(ctx, order, centroid_bounds),
+        _ => best_binned_split_with::<64>(ctx, order, centroid_bounds),
+    }
+}
+
+fn best_binned_split_with<const B: usize>(ctx: &Context, order: &[u32], centroid_bounds: &Aabb) -> Option<Split> {
+    let bins = B;
     let extent = centroid_bounds.extent();
     let scale = Vec3::select(extent.cmpgt(Vec3::ZERO), bins as f32 / extent, Vec3::ZERO);
-    let mut grid = [[Bin::default(); 64]; 3];
-    for &i in order {
-        let c = ctx.centroids[i as usize];
-        let b = ctx.bounds[i as usize];
-        for axis in 0..3 {
-            let bin = &mut grid[axis][bin_index(c[axis], centroid_bounds.min[axis], scale[axis], bins)];
-            bin.bounds = bin.bounds.union(b);
-            bin.count += 1;
-        }
-    }
+    let (min, scale_a) = (Vec3A::from(centroid_bounds.min), Vec3A::from(scale));
+    let grid = if order.len() > PARALLEL_BINNING_THRESHOLD {
+        order
+            .par_chunks(BINNING_CHUNK)
+            .map(|chunk| bin_triangles::<B>(ctx, chunk, min, scale_a))
+            .reduce(|| [[Bin::EMPTY; B]; 3], merge_grids)
+    } else {
+        bin_triangles::<B>(ctx, order, min, scale_a)
+    };
 
     let mut best: Option<Split> = None;
     for axis in 0..3 {
         if extent[axis] <= 0.0 {
             continue;
         }
-        let row = &grid[axis][..bins];
-        // right_cost[k] = area * count of bins k.. (suffix), filled right to left.
-        let mut right_cost = [0.0f64; 64];
-        let mut acc = Bin::default();
+        let row = &grid[axis];
+        // right_cost[k] = area * cost of bins k.. (suffix), filled right to left.
+        let mut right_cost = [0.0f64; B];
+        let mut acc = Bin::EMPTY;
         for k in (1..bins).rev() {
-            acc.bounds = acc.bounds.union(row[k].bounds);
-            acc.count += row[k].count;
-            right_cost[k] = acc.bounds.half_area() * acc.count as f64;
+            acc = acc.merge(row[k]);
+            right_cost[k] = acc.bounds.to_aabb().half_area() * leaf_cost(acc.count as usize);
         }
-        let mut left = Bin::default();
+        let mut left = Bin::EMPTY;
         for k in 1..bins {
-            left.bounds = left.bounds.union(row[k - 1].bounds);
-            left.count += row[k - 1].count;
+            left = left.merge(row[k - 1]);
             if left.count == 0 || left.count as usize == order.len() {
                 continue;
             }
-            let cost = left.bounds.half_area() * left.count as f64 + right_cost[k];
+            let cost = left.bounds.to_aabb().half_area() * leaf_cost(left.count as usize) + right_cost[k];
             if best.as_ref().is_none_or(|b| cost < b.cost) {
                 best = Some(Split { axis, bin: k, cost, scale: scale[axis] });
             }

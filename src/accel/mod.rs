@@ -4,12 +4,24 @@
 
 mod build;
 mod node;
+mod simd;
 mod traverse;
 mod validate;
+mod wide;
+mod wide_traverse;
 
 pub use build::BuildPreset;
 pub use node::Node;
 pub use traverse::Hit;
+pub use wide::{Bvh4, Node4, TriangleBlock};
+
+/// Work done by counted queries, for the benchmarks: interior nodes whose children were box-tested
+/// and triangle blocks (of four) tested.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TraversalStats {
+    pub nodes: u64,
+    pub blocks: u64,
+}
 
 use glam::Vec3;
 
@@ -50,8 +62,8 @@ impl Bvh {
         self.nodes[0].bounds()
     }
 
-    /// Surface area heuristic cost of the tree with unit traversal and intersection costs: the
-    /// expected number of node visits plus triangle tests for a random ray hitting the root box.
+    /// Surface area heuristic cost of the tree with unit traversal and block costs: the expected
+    /// number of node visits plus 4-triangle block tests for a random ray hitting the root box.
     pub fn sah_cost(&self) -> f64 {
         let root_area = self.nodes[0].bounds().half_area();
         if root_area <= 0.0 {
@@ -61,7 +73,7 @@ impl Bvh {
             .nodes
             .iter()
             .map(|n| {
-                let weight = if n.is_leaf() { n.count as f64 } else { 1.0 };
+                let weight = if n.is_leaf() { build::leaf_cost(n.count as usize) } else { 1.0 };
                 weight * n.bounds().half_area()
             })
             .sum();

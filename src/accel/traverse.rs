@@ -21,13 +21,13 @@ pub struct Hit {
 
 /// Slab test expansion that makes the f32 box test conservative: `1 + 2 * gamma(3)` (Ize, "Robust BVH
 /// Ray Traversal", JCGT 2013), so a ray that hits a triangle never misses that triangle's box.
-const BOX_EXPANSION: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
+pub(super) const BOX_EXPANSION: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
 
 /// Slack on the "is this box closer than the best hit?" test. A box entry distance and a triangle's
 /// `t` are rounded differently; without slack, a box whose triangle lies at exactly the best `t`
 /// (a ray through a shared edge or vertex) could be pruned, and the lower-id tie-break would then
 /// depend on the visiting order. About 32 ulps: it costs nothing measurable.
-const PRUNE_SLACK: f32 = 1.0 + 1.0 / (1 << 18) as f32;
+pub(super) const PRUNE_SLACK: f32 = 1.0 + 1.0 / (1 << 18) as f32;
 
 /// Ray constants for the box tests.
 struct BoxRay {

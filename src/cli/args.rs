@@ -18,6 +18,40 @@ pub enum Command {
     Render(RenderArgs),
     /// Print a scene's triangles, materials, lights, bounds and load time.
     Info(InfoArgs),
+    /// Measure BVH build and traversal on the benchmark scenes (Markdown tables on stdout).
+    BenchBvh(BenchBvhArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct BenchBvhArgs {
+    /// Comma-separated benchmark scenes: cornell (built in), bunny, bunny-1m, staircase.
+    #[arg(long, default_value = "cornell,bunny,bunny-1m,staircase")]
+    pub scenes: String,
+
+    /// Folder holding the test scenes (bunny/, bunny-1m/, staircase/).
+    #[arg(long, default_value = "../shared/scenes")]
+    pub scenes_dir: PathBuf,
+
+    /// Thread counts to measure, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "1,2")]
+    pub threads: Vec<usize>,
+
+    /// Timed repetitions per measurement; the median is reported.
+    #[arg(long, default_value_t = 5)]
+    pub repeats: usize,
+
+    /// Seed of the shadow and diffuse rays.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+
+    /// Also write the results as JSON to this file.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+
+    /// Write each scene's triangles and ray sets (binary, see bench/README.md) under this folder,
+    /// for bench/embree_compare.py.
+    #[arg(long)]
+    pub export_rays: Option<PathBuf>,
 }
 
 #[derive(Args, Debug)]

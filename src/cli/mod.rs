@@ -1,6 +1,8 @@
 //! Command-line interface: argument definitions and the subcommands.
 
 mod args;
+mod bench_bvh;
+mod export;
 mod info;
 mod render;
 
@@ -13,5 +15,6 @@ pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Render(args) => render::run(&args),
         Command::Info(args) => info::run(&args),
+        Command::BenchBvh(args) => bench_bvh::run(&args),
     }
 }

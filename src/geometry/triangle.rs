@@ -43,6 +43,13 @@ impl WatertightRay {
     }
 }
 
+impl WatertightRay {
+    /// The axis permutation `[kx, ky, kz]` and shear `[sx, sy, sz]`, for SIMD variants of the test.
+    pub fn permutation_and_shear(&self) -> ([usize; 3], [f32; 3]) {
+        ([self.kx, self.ky, self.kz], [self.sx, self.sy, self.sz])
+    }
+}
+
 /// Where a ray met a triangle: `t` along the ray, and the barycentric weights `u` of the second and
 /// `v` of the third vertex (the first has `1 - u - v`).
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -1,0 +1,127 @@
+//! Warps from the unit square to triangles, hemispheres and spheres.
+//!
+//! Every warp is a pure function of its uniform sample `u ∈ [0, 1]²` and comes as a triple:
+//! `sample_*`, `*_pdf` and `invert_*_sample`. Without an RNG inside, they can be driven by
+//! independent or quasi-random numbers alike, checked on grids, and round-tripped in tests. Each pdf
+//! names its measure; directions are in the local frame of [`crate::math::Frame`] (`z` = normal).
+//!
+//! All sample functions accept `u` on the closed square, including exact 0 and 1, without NaN.
+
+use std::f32::consts::{FRAC_1_PI, TAU};
+
+use glam::{Vec2, Vec3};
+
+/// Uniform point on a triangle as barycentric coordinates `(b0, b1, b2)`, weights of vertices 0, 1, 2.
+///
+/// Global Illumination Compendium (Dutré), eq. 18: `b0 = 1 − √u₁`, `b1 = u₂·√u₁`. `b2` is taken as
+/// `1 − b0 − b1` so that the three always sum to one.
+#[inline]
+pub fn sample_uniform_triangle(u: Vec2) -> Vec3 {
+    let s = u.x.sqrt();
+    let b0 = 1.0 - s;
+    let b1 = u.y * s;
+    Vec3::new(b0, b1, 1.0 - b0 - b1)
+}
+
+/// Density of [`sample_uniform_triangle`] with respect to **area** on a triangle of area `area`.
+///
+/// Lights convert it to solid angle with `distance² / cos θ` at the one place that needs it.
+#[inline]
+pub fn uniform_triangle_pdf(area: f32) -> f32 {
+    1.0 / area
+}
+
+/// The `u` that [`sample_uniform_triangle`] maps to the barycentrics `b`.
+///
+/// `√u₁ = 1 − b0` is computed as `b1 + b2`, which keeps its precision near vertex 0.
+#[inline]
+pub fn invert_uniform_triangle_sample(b: Vec3) -> Vec2 {
+    let s = b.y + b.z;
+    let v = if s > 0.0 { (b.y / s).min(1.0) } else { 0.0 };
+    Vec2::new((s * s).min(1.0), v)
+}
+
+/// Cosine-weighted direction on the hemisphere around `+z`.
+///
+/// Global Illumination Compendium, eq. 35 (Malley's method: uniform on the disk, projected up):
+/// `sin θ = √u₁`, `φ = 2π·u₂`, so `cos²θ = 1 − u₁` is uniform as the density `cos θ / π` requires.
+/// This orientation (rather than `cos θ = √u₁`) keeps samplers' `u₁ ∈ [0, 1)` off the horizon,
+/// where the pdf is 0: the lowest direction it can produce has `cos θ = √(2⁻²⁴) > 0`.
+#[inline]
+pub fn sample_cosine_hemisphere(u: Vec2) -> Vec3 {
+    let sin_theta = u.x.sqrt();
+    let cos_theta = (1.0 - u.x).max(0.0).sqrt();
+    direction(sin_theta, cos_theta, TAU * u.y)
+}
+
+/// Density of [`sample_cosine_hemisphere`] with respect to **solid angle**: `max(cos θ, 0) / π`.
+#[inline]
+pub fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
+    cos_theta.max(0.0) * FRAC_1_PI
+}
+
+/// The `u` that [`sample_cosine_hemisphere`] maps to the unit direction `w` (`w.z ≥ 0`).
+#[inline]
+pub fn invert_cosine_hemisphere_sample(w: Vec3) -> Vec2 {
+    Vec2::new((w.x * w.x + w.y * w.y).min(1.0), azimuth_fraction(w))
+}
+
+/// Uniform direction on the hemisphere around `+z`: `cos θ = 1 − u₁`, `φ = 2π·u₂`
+/// (Archimedes: height on the sphere is uniform in area). `u₁ < 1` never reaches the horizon.
+#[inline]
+pub fn sample_uniform_hemisphere(u: Vec2) -> Vec3 {
+    let cos_theta = 1.0 - u.x;
+    // √(1 − cos²θ) written as √(u₁(2 − u₁)) keeps its precision near the pole.
+    let sin_theta = (u.x * (2.0 - u.x)).max(0.0).sqrt();
+    direction(sin_theta, cos_theta, TAU * u.y)
+}
+
+/// Density of [`sample_uniform_hemisphere`] with respect to **solid angle**: `1 / 2π` on the
+/// closed upper hemisphere (`cos θ ≥ 0`), 0 below.
+#[inline]
+pub fn uniform_hemisphere_pdf(cos_theta: f32) -> f32 {
+    if cos_theta >= 0.0 { 0.5 * FRAC_1_PI } else { 0.0 }
+}
+
+/// The `u` that [`sample_uniform_hemisphere`] maps to the unit direction `w` (`w.z ≥ 0`).
+#[inline]
+pub fn invert_uniform_hemisphere_sample(w: Vec3) -> Vec2 {
+    Vec2::new((1.0 - w.z).clamp(0.0, 1.0), azimuth_fraction(w))
+}
+
+/// Uniform direction on the unit sphere: `cos θ = 1 − 2u₁`, `φ = 2π·u₂`.
+#[inline]
+pub fn sample_uniform_sphere(u: Vec2) -> Vec3 {
+    let cos_theta = 1.0 - 2.0 * u.x;
+    // √(1 − cos²θ) = 2√(u₁(1 − u₁)): exact at both poles.
+    let sin_theta = 2.0 * (u.x * (1.0 - u.x)).max(0.0).sqrt();
+    direction(sin_theta, cos_theta, TAU * u.y)
+}
+
+/// Density of [`sample_uniform_sphere`] with respect to **solid angle**: `1 / 4π` everywhere.
+#[inline]
+pub fn uniform_sphere_pdf() -> f32 {
+    0.25 * FRAC_1_PI
+}
+
+/// The `u` that [`sample_uniform_sphere`] maps to the unit direction `w`.
+#[inline]
+pub fn invert_uniform_sphere_sample(w: Vec3) -> Vec2 {
+    Vec2::new((0.5 * (1.0 - w.z)).clamp(0.0, 1.0), azimuth_fraction(w))
+}
+
+/// The unit vector with polar angle given by its sine and cosine and azimuth `phi`.
+#[inline]
+fn direction(sin_theta: f32, cos_theta: f32, phi: f32) -> Vec3 {
+    let (sin_phi, cos_phi) = phi.sin_cos();
+    Vec3::new(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta)
+}
+
+/// `φ / 2π ∈ [0, 1)` for the azimuth `φ` of `w` around `+z`; 0 on the axis, where `φ` is arbitrary.
+#[inline]
+fn azimuth_fraction(w: Vec3) -> f32 {
+    let f = w.y.atan2(w.x) / TAU;
+    let f = if f < 0.0 { f + 1.0 } else { f };
+    // `f + 1` rounds to exactly 1 for tiny negative angles; the sample for that is u₂ = 0 anyway.
+    if f >= 1.0 { 0.0 } else { f }
+}
