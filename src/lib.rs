@@ -13,7 +13,7 @@
 //! let scene = Scene::builtin()?;
 //! let camera = Camera::from_orbiter(&builtin::cornell_orbiter()?, 64, 48);
 //! let world = World::new(scene, Default::default());
-//! let options = RenderOptions { mode: Mode::Shadows, samples: 1, seed: 0 };
+//! let options = RenderOptions::new(Mode::Shadows, 1);
 //! let output = render(&world, &camera, &options, &|_| {})?;
 //! assert_eq!(output.image.pixels.len(), 64 * 48);
 //! assert!(output.image.pixels.iter().any(|p| p.x > 0.0), "the lit box is not black");

@@ -7,7 +7,10 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
-use crate::integrators::{Hits, Integrator, Materials, Mode, SampleContext, Shadows};
+use crate::integrators::{
+    AmbientOcclusion, Direct, Hits, Integrator, LightSampling, Materials, Mode, SampleContext, Shadows, dims,
+};
+use crate::sampler::{Sampler, SamplerKind};
 use crate::scene::camera::Camera;
 use crate::world::World;
 
@@ -18,9 +21,31 @@ const TILE_SIZE: u32 = 16;
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderOptions {
     pub mode: Mode,
-    /// Samples per light or per hemisphere, for the Monte Carlo modes.
+    /// Samples per light (or in total, with power light sampling) or per hemisphere.
     pub samples: u32,
+    /// Camera samples per pixel; 1 is the lab's single ray through the pixel centre, more are
+    /// jittered inside the pixel.
+    pub spp: u32,
     pub seed: u64,
+    pub sampler: SamplerKind,
+    pub light_sampling: LightSampling,
+    /// Ambient occlusion rays stop at this distance (infinite: visibility of the sky).
+    pub ao_distance: f32,
+}
+
+impl RenderOptions {
+    /// The options of a lab image: one camera ray per pixel centre, independent samples.
+    pub fn new(mode: Mode, samples: u32) -> Self {
+        RenderOptions {
+            mode,
+            samples,
+            spp: 1,
+            seed: 0,
+            sampler: SamplerKind::Independent,
+            light_sampling: LightSampling::PerLight,
+            ao_distance: f32::INFINITY,
+        }
+    }
 }
 
 /// Linear RGB pixels, row 0 at the top.
@@ -76,30 +101,64 @@ pub fn render(
     if options.samples == 0 {
         return Err(Error::invalid("--samples must be at least 1"));
     }
+    if options.spp == 0 {
+        return Err(Error::invalid("--spp must be at least 1"));
+    }
+    if options.ao_distance.is_nan() || options.ao_distance <= 0.0 {
+        return Err(Error::invalid(format!("--ao-distance must be positive, got {}", options.ao_distance)));
+    }
+    let n = options.samples;
     Ok(match options.mode {
-        Mode::Hits => render_with(&Hits, world, camera, progress),
-        Mode::Materials => render_with(&Materials, world, camera, progress),
-        Mode::Shadows => render_with(&Shadows, world, camera, progress),
+        Mode::Hits => render_with(&Hits, world, camera, options, progress),
+        Mode::Materials => render_with(&Materials, world, camera, options, progress),
+        Mode::Shadows => render_with(&Shadows, world, camera, options, progress),
+        Mode::Direct => render_with(&Direct::new(world, n, options.light_sampling), world, camera, options, progress),
+        Mode::AmbientOcclusion => {
+            let ao = AmbientOcclusion { samples: n, distance: options.ao_distance };
+            render_with(&ao, world, camera, options, progress)
+        }
     })
+}
+
+/// The estimate of pixel `(x, y)`: the mean over its camera samples.
+#[inline]
+fn render_pixel<I: Integrator>(
+    integrator: &I,
+    world: &World,
+    camera: &Camera,
+    spp: u32,
+    (x, y): (u32, u32),
+    ctx: &mut SampleContext,
+) -> Vec3 {
+    ctx.pixel = y * camera.width + x;
+    let mut sum = Vec3::ZERO;
+    for sample in 0..spp {
+        ctx.sample = sample;
+        let offset = if spp == 1 { glam::Vec2::splat(0.5) } else { ctx.point_2d(dims::PIXEL, 0, 1) };
+        let ray = camera.ray(x as f32 + offset.x, y as f32 + offset.y);
+        sum += integrator.radiance(world, &ray, ctx);
+    }
+    sum / spp as f32
 }
 
 fn render_with<I: Integrator>(
     integrator: &I,
     world: &World,
     camera: &Camera,
+    options: &RenderOptions,
     progress: &(dyn Fn(u64) + Sync),
 ) -> RenderOutput {
     let start = Instant::now();
+    let sampler = Sampler::new(options.sampler, options.seed);
     let tiles = tiles(camera.width, camera.height);
     let rendered: Vec<(Vec<Vec3>, u64)> = tiles
         .par_iter()
         .map(|tile| {
-            let mut ctx = SampleContext::default();
+            let mut ctx = SampleContext { sampler: &sampler, pixel: 0, sample: 0, rays: 0 };
             let mut pixels = Vec::with_capacity(((tile.x1 - tile.x0) * (tile.y1 - tile.y0)) as usize);
             for y in tile.y0..tile.y1 {
                 for x in tile.x0..tile.x1 {
-                    let ray = camera.ray(x as f32 + 0.5, y as f32 + 0.5);
-                    pixels.push(integrator.radiance(world, &ray, &mut ctx));
+                    pixels.push(render_pixel(integrator, world, camera, options.spp, (x, y), &mut ctx));
                 }
             }
             progress(pixels.len() as u64);

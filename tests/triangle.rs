@@ -93,3 +93,57 @@ fn no_ray_slips_through_a_closed_mesh() {
     }
     assert!(rays > 20_000);
 }
+
+/// A long wall (1 x 20000) hit at distance ~2: its vertex depths (~1e4) dwarf the hit distance, so
+/// the f32 distance cancels; the test must still find every hit, checked against an exact answer.
+#[test]
+fn long_slivers_far_beyond_the_hit_are_still_hit() {
+    let far = 1.0e4f32;
+    let p = [Vec3::new(1.0, 0.0, -far), Vec3::new(1.0, 1.0, -far), Vec3::new(1.0, 1.0, far), Vec3::new(1.0, 0.0, far)];
+    let mut rng = TestRng(3);
+    let mut checked = 0;
+    for _ in 0..200_000 {
+        let dir = rng.direction();
+        let origin = Vec3::new(0.0, 1.0e-5, 0.0);
+        // Exact answer: the plane x = 1 is reached at t = 1/dx, inside the wall if 0 <= y <= 1.
+        let t = (1.0 - origin.x as f64) / dir.x as f64;
+        let y = origin.y as f64 + t * dir.y as f64;
+        let clearly_inside = dir.x > 0.01 && (0.01..0.99).contains(&y) && (t * dir.z as f64).abs() < 1e3;
+        let clearly_outside = dir.x < 0.0 || !(-0.01..1.01).contains(&y);
+        if !(clearly_inside || clearly_outside) {
+            continue;
+        }
+        let ray = WatertightRay::new(&Ray::new(origin, dir));
+        let hits: Vec<f32> = [(p[0], p[1], p[2]), (p[0], p[2], p[3])]
+            .iter()
+            .filter_map(|&(a, b, c)| intersect_triangle(&ray, f32::INFINITY, a, b, c))
+            .map(|h| h.t)
+            .collect();
+        assert_eq!(!hits.is_empty(), clearly_inside, "dir {dir:?}: exact t {t}, y {y}, got {hits:?}");
+        if let Some(&got) = hits.first() {
+            assert!((got as f64 - t).abs() < 1e-4 * t, "t {got} vs {t}");
+        }
+        checked += 1;
+    }
+    assert!(checked > 100_000);
+}
+
+/// A ray through the shared diagonal of a large quad, where the distance also needs the f64
+/// fallback: exactly one of the two triangles must still report the hit.
+#[test]
+fn shared_edge_of_a_large_quad_is_hit_when_the_distance_falls_back_to_f64() {
+    let s = 20.0f32;
+    let p = [Vec3::new(-s, 0.0, -s), Vec3::new(-s, 0.0, s), Vec3::new(s, 0.0, s), Vec3::new(s, 0.0, -s)];
+    let mut rng = TestRng(9);
+    for _ in 0..10_000 {
+        let along = rng.range(-0.5, 0.5);
+        let target = Vec3::new(along, 0.0, along);
+        let eye = Vec3::new(rng.range(-1.0, 1.0), rng.range(0.1, 1.0), rng.range(2.0, 4.0));
+        let ray = WatertightRay::new(&Ray::new(eye, target - eye));
+        let hits = [(p[0], p[1], p[2]), (p[0], p[2], p[3])]
+            .iter()
+            .filter(|&&(a, b, c)| intersect_triangle(&ray, f32::INFINITY, a, b, c).is_some())
+            .count();
+        assert!(hits >= 1, "ray from {eye:?} through the diagonal at {target:?} slipped through");
+    }
+}

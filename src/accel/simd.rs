@@ -56,6 +56,11 @@ mod imp {
         pub fn ne(self, b: Self) -> Mask4 {
             unsafe { Mask4(_mm_cmpneq_ps(self.0, b.0)) }
         }
+        /// Lane-wise absolute value (clears the sign bit).
+        #[inline(always)]
+        pub fn abs(self) -> Self {
+            unsafe { F32x4(_mm_andnot_ps(_mm_set1_ps(-0.0), self.0)) }
+        }
         /// Lanes that are neither infinite nor NaN.
         #[inline(always)]
         pub fn is_finite(self) -> Mask4 {
@@ -162,6 +167,9 @@ mod imp {
         }
         pub fn ne(self, b: Self) -> Mask4 {
             cmp(self.0, b.0, |x, y| x != y)
+        }
+        pub fn abs(self) -> Self {
+            F32x4(self.0.map(f32::abs))
         }
         pub fn is_finite(self) -> Mask4 {
             Mask4(self.0.map(f32::is_finite))

@@ -12,7 +12,7 @@ use super::simd::F32x4;
 use super::traverse::{BOX_EXPANSION, PRUNE_SLACK};
 use super::wide::{Bvh4, LEAF_BIT, Node4, TriangleBlock, leaf_blocks};
 use super::{Hit, TraversalStats};
-use crate::geometry::triangle::{WatertightRay, intersect_triangle};
+use crate::geometry::triangle::{CANCELLATION_RATIO, WatertightRay, intersect_triangle};
 use crate::math::Ray;
 
 /// Each wide level pushes at most three siblings.
@@ -128,10 +128,15 @@ fn intersect_block(ray: &TriangleRay4, block: &TriangleBlock, tmax: f32) -> Bloc
     let positive = u.gt(zero) | v.gt(zero) | w.gt(zero);
     let inside = !(negative.bits() & positive.bits()) & 0xF;
     let det = u + v + w;
-    let t_scaled = u * (sz * a_kz) + v * (sz * b_kz) + w * (sz * c_kz);
-    // Lanes the scalar test would redo in f64: an edge function exactly 0, or overflow.
-    let needs_scalar =
-        (u.eq(zero) | v.eq(zero) | w.eq(zero)).bits() | !(det.is_finite() & t_scaled.is_finite()).bits() & 0xF;
+    let (az, bz, cz) = (sz * a_kz, sz * b_kz, sz * c_kz);
+    let t_scaled = u * az + v * bz + w * cz;
+    // Lanes the scalar test redoes in f64: an edge function exactly 0, overflow, or cancellation
+    // (the same `cancels` condition, evaluated with the same operations).
+    let zero_edge = (u.eq(zero) | v.eq(zero) | w.eq(zero)).bits();
+    let overflow = !(det.is_finite() & t_scaled.is_finite()).bits() & 0xF;
+    let depth_sum = az.abs() + bz.abs() + cz.abs();
+    let cancel = (depth_sum * det.abs()).gt(F32x4::splat(CANCELLATION_RATIO) * t_scaled.abs()).bits();
+    let needs_scalar = zero_edge | (inside & (overflow | cancel));
 
     let inv_det = F32x4::splat(1.0) / det;
     let t = t_scaled * inv_det;

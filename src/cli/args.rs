@@ -68,6 +68,26 @@ pub enum ModeArg {
     Materials,
     /// Hard shadows: one shadow ray to each light triangle's centroid.
     Shadows,
+    /// Soft shadows: direct light integrated over the area lights with --samples points.
+    Direct,
+    /// Ambient occlusion: fraction of --samples cosine-weighted directions that see the sky.
+    Ao,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum SamplerArg {
+    /// Hashed independent random numbers.
+    Independent,
+    /// Owen-scrambled Sobol points: lower error for the same sample count.
+    Sobol,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum LightSamplingArg {
+    /// --samples points on every light triangle (the lab's count).
+    PerLight,
+    /// --samples points in total, lights chosen in proportion to their power.
+    Power,
 }
 
 impl From<ModeArg> for Mode {
@@ -76,6 +96,8 @@ impl From<ModeArg> for Mode {
             ModeArg::Hits => Mode::Hits,
             ModeArg::Materials => Mode::Materials,
             ModeArg::Shadows => Mode::Shadows,
+            ModeArg::Direct => Mode::Direct,
+            ModeArg::Ao => Mode::AmbientOcclusion,
         }
     }
 }
@@ -89,9 +111,30 @@ pub struct RenderArgs {
     #[arg(long, value_enum, default_value_t = ModeArg::Shadows)]
     pub mode: ModeArg,
 
-    /// Samples per light triangle or per hemisphere, for the Monte Carlo modes.
-    #[arg(long, default_value_t = 1)]
+    /// Samples per light triangle (direct), in total (direct with power light sampling) or per
+    /// hemisphere (ao).
+    #[arg(long, default_value_t = 16)]
     pub samples: u32,
+
+    /// Camera samples per pixel; 1 is one ray through the pixel centre, more are jittered in the pixel.
+    #[arg(long, default_value_t = 1)]
+    pub spp: u32,
+
+    /// Random number generator for the Monte Carlo modes.
+    #[arg(long, value_enum, default_value_t = SamplerArg::Independent)]
+    pub sampler: SamplerArg,
+
+    /// How direct lighting chooses its light samples.
+    #[arg(long, value_enum, default_value_t = LightSamplingArg::PerLight)]
+    pub light_sampling: LightSamplingArg,
+
+    /// Ambient occlusion rays stop at this distance (default: infinite, visibility of the sky).
+    #[arg(long)]
+    pub ao_distance: Option<f32>,
+
+    /// Set the emission Ke of a material, NAME=r,g,b (repeatable); e.g. Emission=5,5,5 on the staircase.
+    #[arg(long, value_parser = parse_emission)]
+    pub emission: Vec<(String, Vec3)>,
 
     /// Image size, WIDTHxHEIGHT.
     #[arg(long, value_parser = parse_size, default_value = "1024x768")]
@@ -146,6 +189,15 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
         return Err(format!("image size {w}x{h} has no pixels"));
     }
     Ok((w, h))
+}
+
+fn parse_emission(s: &str) -> Result<(String, Vec3), String> {
+    let (name, value) = s.split_once('=').ok_or_else(|| format!("expected NAME=r,g,b, got '{s}'"))?;
+    let ke = parse_vec3(value)?;
+    if ke.min_element() < 0.0 {
+        return Err(format!("emission must not be negative, got '{value}'"));
+    }
+    Ok((name.to_string(), ke))
 }
 
 fn parse_vec3(s: &str) -> Result<Vec3, String> {

@@ -5,13 +5,15 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 use lumiere::accel::BuildPreset;
 use lumiere::image_io::{PngEncoding, check_output_path, check_writable, write_atomically, write_image};
+use lumiere::integrators::LightSampling;
 use lumiere::render::{RenderOptions, render};
+use lumiere::sampler::SamplerKind;
 use lumiere::scene::camera::{Camera, Orbiter};
 use lumiere::scene::{Scene, builtin};
 use lumiere::world::World;
 use lumiere::{Error, Result};
 
-use super::args::RenderArgs;
+use super::args::{LightSamplingArg, RenderArgs, SamplerArg};
 
 pub fn run(args: &RenderArgs) -> Result<()> {
     // Refuse a bad output path before spending minutes on a render.
@@ -29,10 +31,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
 
 fn render_in_pool(args: &RenderArgs, threads: usize) -> Result<()> {
     let load_start = Instant::now();
-    let scene = match &args.scene {
+    let mut scene = match &args.scene {
         Some(path) => Scene::load(path)?,
         None => Scene::builtin()?,
     };
+    for (name, ke) in &args.emission {
+        scene.set_emission(name, *ke)?;
+    }
     let load_ms = load_start.elapsed().as_secs_f64() * 1e3;
     for warning in &scene.warnings {
         eprintln!("lumiere: warning: {warning}");
@@ -43,7 +48,21 @@ fn render_in_pool(args: &RenderArgs, threads: usize) -> Result<()> {
     let world = World::new(scene, BuildPreset::Default);
     let build_ms = build_start.elapsed().as_secs_f64() * 1e3;
 
-    let options = RenderOptions { mode: args.mode.into(), samples: args.samples, seed: args.seed };
+    let options = RenderOptions {
+        mode: args.mode.into(),
+        samples: args.samples,
+        spp: args.spp,
+        seed: args.seed,
+        sampler: match args.sampler {
+            SamplerArg::Independent => SamplerKind::Independent,
+            SamplerArg::Sobol => SamplerKind::Sobol,
+        },
+        light_sampling: match args.light_sampling {
+            LightSamplingArg::PerLight => LightSampling::PerLight,
+            LightSamplingArg::Power => LightSampling::Power,
+        },
+        ao_distance: args.ao_distance.unwrap_or(f32::INFINITY),
+    };
     let bar = progress_bar(u64::from(camera.width) * u64::from(camera.height));
     let output = render(&world, &camera, &options, &|pixels| bar.inc(pixels))?;
     bar.finish_and_clear();
@@ -70,6 +89,8 @@ fn render_in_pool(args: &RenderArgs, threads: usize) -> Result<()> {
             "width": camera.width,
             "height": camera.height,
             "samples": options.samples,
+            "spp": options.spp,
+            "sampler": format!("{:?}", options.sampler).to_lowercase(),
             "seed": options.seed,
             "threads": threads,
             "triangles": world.scene.mesh.triangle_count(),

@@ -88,10 +88,17 @@ pub fn intersect_triangle(ray: &WatertightRay, tmax: f32, p0: Vec3, p1: Vec3, p2
         return None;
     }
     let det = u + v + w;
-    let t_scaled = u * (ray.sz * a[kz]) + v * (ray.sz * b[kz]) + w * (ray.sz * c[kz]);
+    let (az, bz, cz) = (ray.sz * a[kz], ray.sz * b[kz], ray.sz * c[kz]);
+    let t_scaled = u * az + v * bz + w * cz;
     if !(det.is_finite() && t_scaled.is_finite()) {
         // Products of coordinates beyond ~1e18 overflow f32 (or NaN from inf - inf).
         return intersect_triangle_f64(ray, tmax, p0, p1, p2);
+    }
+    if cancels(az, bz, cz, det, t_scaled) {
+        // The f32 edge tests above already decided, watertightly, that the ray crosses the triangle;
+        // only the distance is recomputed. Re-deciding the edges in f64 (with a differently rounded
+        // shear) could reject a ray on a shared edge from both triangles.
+        return distance_f64(ray, tmax, p0, p1, p2);
     }
     if det == 0.0 || t_scaled * det <= 0.0 {
         return None;
@@ -101,21 +108,45 @@ pub fn intersect_triangle(ray: &WatertightRay, tmax: f32, p0: Vec3, p1: Vec3, p2
     (t <= tmax).then_some(TriangleHit { t, u: v * inv_det, v: w * inv_det })
 }
 
-/// The same test in f64, for inputs whose f32 products overflow. Rare, so it favours clarity.
+/// True when the hit distance is a small difference of large vertex depths: `t` is a weighted mean
+/// of the depths `az, bz, cz`, and when they are much larger than `t` (a long sliver reaching far in
+/// front of and behind the origin), the f32 rounding of the edge functions is multiplied by that
+/// ratio and `t` can come out 0 or negative for a clean hit (seen on a 1 x 20000 wall). Such cases
+/// go to f64. For ordinary triangles the depths are close to `t` and this never fires.
+#[inline(always)]
+pub fn cancels(az: f32, bz: f32, cz: f32, det: f32, t_scaled: f32) -> bool {
+    (az.abs() + bz.abs() + cz.abs()) * det.abs() > CANCELLATION_RATIO * t_scaled.abs()
+}
+
+/// Largest ratio of summed vertex depths to hit distance still trusted in f32.
+pub const CANCELLATION_RATIO: f32 = 16.0;
+
+/// Sheared corner coordinates and edge functions in f64: `(u, v, w)` and the depths `(az, bz, cz)`.
 #[cold]
-fn intersect_triangle_f64(ray: &WatertightRay, tmax: f32, p0: Vec3, p1: Vec3, p2: Vec3) -> Option<TriangleHit> {
+fn edge_functions_f64(ray: &WatertightRay, p0: Vec3, p1: Vec3, p2: Vec3) -> ([f64; 3], [f64; 3]) {
     let (kx, ky, kz) = (ray.kx, ray.ky, ray.kz);
     let o = ray.origin.as_dvec3();
     let (sx, sy, sz) = (ray.sx as f64, ray.sy as f64, ray.sz as f64);
     let [a, b, c] = [p0, p1, p2].map(|p| p.as_dvec3() - o);
     let shear = |p: glam::DVec3| (p[kx] - sx * p[kz], p[ky] - sy * p[kz], sz * p[kz]);
     let ((ax, ay, az), (bx, by, bz), (cx, cy, cz)) = (shear(a), shear(b), shear(c));
-    let u = cx * by - cy * bx;
-    let v = ax * cy - ay * cx;
-    let w = bx * ay - by * ax;
+    ([cx * by - cy * bx, ax * cy - ay * cx, bx * ay - by * ax], [az, bz, cz])
+}
+
+/// The whole test in f64, for inputs whose f32 products overflow. Rare, so it favours clarity.
+#[cold]
+fn intersect_triangle_f64(ray: &WatertightRay, tmax: f32, p0: Vec3, p1: Vec3, p2: Vec3) -> Option<TriangleHit> {
+    let ([u, v, w], _) = edge_functions_f64(ray, p0, p1, p2);
     if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
         return None;
     }
+    distance_f64(ray, tmax, p0, p1, p2)
+}
+
+/// Distance and barycentrics in f64 for a ray already known to cross the triangle's edges.
+#[cold]
+fn distance_f64(ray: &WatertightRay, tmax: f32, p0: Vec3, p1: Vec3, p2: Vec3) -> Option<TriangleHit> {
+    let ([u, v, w], [az, bz, cz]) = edge_functions_f64(ray, p0, p1, p2);
     let det = u + v + w;
     let t = (u * az + v * bz + w * cz) / det;
     // `t > 0.0` is false for NaN too, which rejects it.

@@ -1,14 +1,19 @@
 //! Integrators: one file per technique, all computing the radiance arriving along a camera ray.
 
+mod ao;
+mod direct;
 mod hits;
 mod materials;
 mod shadows;
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 use crate::math::Ray;
+use crate::sampler::Sampler;
 use crate::world::World;
 
+pub use ao::AmbientOcclusion;
+pub use direct::{Direct, LightSampling};
 pub use hits::Hits;
 pub use materials::Materials;
 pub use shadows::Shadows;
@@ -22,6 +27,10 @@ pub enum Mode {
     Materials,
     /// Direct light from each light triangle's centroid, one shadow ray each (lab figure 3).
     Shadows,
+    /// Direct light integrated over the area lights with N samples (lab figures 4-6).
+    Direct,
+    /// Ambient occlusion with N cosine-weighted directions (lab figures 7-9).
+    AmbientOcclusion,
 }
 
 impl Mode {
@@ -30,14 +39,48 @@ impl Mode {
             Mode::Hits => "hits",
             Mode::Materials => "materials",
             Mode::Shadows => "shadows",
+            Mode::Direct => "direct",
+            Mode::AmbientOcclusion => "ao",
         }
     }
 }
 
-/// Per-sample state handed to an integrator; counts the rays it traces.
-#[derive(Debug, Default)]
-pub struct SampleContext {
+/// Sample dimensions, numbered once here so that no two uses of the sampler collide.
+pub mod dims {
+    /// Position inside the pixel (anti-aliasing jitter).
+    pub const PIXEL: u32 = 0;
+    /// Which light, for power-proportional light selection.
+    pub const LIGHT_CHOICE: u32 = 1;
+    /// Hemisphere direction, for ambient occlusion.
+    pub const HEMISPHERE: u32 = 2;
+    /// Point on a light; per-light sampling uses `LIGHT_POINT + light index`.
+    pub const LIGHT_POINT: u32 = 3;
+}
+
+/// Per-sample state handed to an integrator: where the sample is, its random numbers, and a count
+/// of the rays it traces (visibility queries included).
+#[derive(Debug)]
+pub struct SampleContext<'a> {
+    pub sampler: &'a Sampler,
+    /// `y * width + x`.
+    pub pixel: u32,
+    /// Index of this camera sample within its pixel (0 .. spp).
+    pub sample: u32,
     pub rays: u64,
+}
+
+impl SampleContext<'_> {
+    /// The `k`-th of `n` 2D points of `dimension` for this camera sample. Consecutive camera samples
+    /// own consecutive blocks of `n` indices, so a stratified sampler stratifies across all of them.
+    #[inline]
+    pub fn point_2d(&self, dimension: u32, k: u32, n: u32) -> Vec2 {
+        self.sampler.get_2d(self.pixel, self.sample * n + k, dimension)
+    }
+
+    #[inline]
+    pub fn point_1d(&self, dimension: u32, k: u32, n: u32) -> f32 {
+        self.sampler.get_1d(self.pixel, self.sample * n + k, dimension)
+    }
 }
 
 /// Radiance along a camera ray. Implemented by plain structs and used through generics, so the

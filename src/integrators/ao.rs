@@ -1,0 +1,36 @@
+use glam::Vec3;
+
+use super::{Integrator, SampleContext, dims};
+use crate::math::{Frame, Ray, offset_ray_origin};
+use crate::sampling::warp::sample_cosine_hemisphere;
+use crate::world::World;
+
+/// Ambient occlusion: the fraction of `samples` cosine-weighted directions about the normal (on the
+/// viewer's side) that reach the sky, or that travel at least `distance` without a hit.
+///
+/// With directions drawn with pdf `cos(theta)/pi`, the estimator of `(1/pi) * integral of V cos(theta)`
+/// is `(1/N) sum V`: every weight is exactly 1 (GI compendium eq. 35).
+pub struct AmbientOcclusion {
+    pub samples: u32,
+    /// Rays stop here; `f32::INFINITY` for the lab's "visibility of the sky".
+    pub distance: f32,
+}
+
+impl Integrator for AmbientOcclusion {
+    fn radiance(&self, world: &World, ray: &Ray, ctx: &mut SampleContext) -> Vec3 {
+        ctx.rays += 1;
+        let Some(hit) = world.intersect(ray) else { return Vec3::ZERO };
+        let surface = world.surface(ray, &hit);
+        let frame = Frame::from_normal(surface.ng);
+        let origin = offset_ray_origin(surface.p, surface.ng);
+        let mut visible = 0u32;
+        for k in 0..self.samples {
+            let local = sample_cosine_hemisphere(ctx.point_2d(dims::HEMISPHERE, k, self.samples));
+            let direction = frame.to_world(local);
+            let probe = Ray { origin, dir: direction, tmax: self.distance };
+            visible += u32::from(!world.occluded(&probe));
+        }
+        ctx.rays += u64::from(self.samples);
+        Vec3::splat(visible as f32 / self.samples as f32)
+    }
+}

@@ -1,0 +1,113 @@
+use std::f32::consts::FRAC_1_PI;
+
+use glam::Vec3;
+
+use super::{Integrator, SampleContext, dims};
+use crate::lights::AreaLight;
+use crate::math::{Ray, offset_ray_origin};
+use crate::sampling::distrib::AliasTable;
+use crate::sampling::warp::sample_uniform_triangle;
+use crate::world::{SurfacePoint, World};
+
+/// How the direct-light estimator spends its samples.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum LightSampling {
+    /// N points on every light triangle, as the lab counts (N * lights shadow rays a pixel).
+    #[default]
+    PerLight,
+    /// N points in total, each on a light chosen in proportion to its power (alias table, O(1)).
+    Power,
+}
+
+/// Direct lighting from area lights with Lambertian receivers (lab figures 4-6):
+/// `Lr = (1/N) sum Le * Kd/pi * V * cos(theta) cos(theta_s) / d^2 / pdf(s)`, with `s` uniform on
+/// a light triangle (GI compendium eq. 18, area pdf `1/A`), or on a light picked by power (area pdf
+/// `pmf / A`). Where the camera sees a light directly, its emission.
+pub struct Direct {
+    pub samples: u32,
+    pub light_sampling: LightSampling,
+    /// Built from the lights' power for `LightSampling::Power`; `None` when there are no lights.
+    power: Option<AliasTable>,
+}
+
+impl Direct {
+    pub fn new(world: &World, samples: u32, light_sampling: LightSampling) -> Direct {
+        let power = match light_sampling {
+            LightSampling::Power => {
+                let weights: Vec<f32> = world.scene.lights.iter().map(|l| l.power().element_sum()).collect();
+                AliasTable::new(&weights)
+            }
+            LightSampling::PerLight => None,
+        };
+        Direct { samples, light_sampling, power }
+    }
+}
+
+/// The unoccluded contribution of the light point `y` to `surface`, divided by the area pdf, and
+/// the shadow segment that decides its visibility; `None` when a cosine is not positive.
+#[inline(always)]
+fn light_sample(surface: &SurfacePoint, origin: Vec3, light: &AreaLight, y: Vec3) -> Option<(Vec3, Ray)> {
+    let to_light = y - surface.p;
+    let d2 = to_light.length_squared();
+    let wi = to_light / d2.sqrt();
+    let cos_surface = surface.ns.dot(wi);
+    let cos_light = -light.normal.dot(wi);
+    if cos_surface <= 0.0 || cos_light <= 0.0 || surface.ng.dot(wi) <= 0.0 {
+        return None;
+    }
+    let target = offset_ray_origin(y, light.normal);
+    Some((light.emission * (cos_surface * cos_light / d2), Ray::segment(origin, target)))
+}
+
+#[inline(always)]
+fn point_on(light: &AreaLight, u: glam::Vec2) -> Vec3 {
+    let b = sample_uniform_triangle(u);
+    let [p0, p1, p2] = light.vertices;
+    b.x * p0 + b.y * p1 + b.z * p2
+}
+
+impl Integrator for Direct {
+    fn radiance(&self, world: &World, ray: &Ray, ctx: &mut SampleContext) -> Vec3 {
+        ctx.rays += 1;
+        let Some(hit) = world.intersect(ray) else { return Vec3::ZERO };
+        let material = world.scene.material(hit.triangle);
+        if material.is_emissive() {
+            return material.ke;
+        }
+        let surface = world.surface(ray, &hit);
+        let origin = offset_ray_origin(surface.p, surface.ng);
+        let n = self.samples;
+        let mut sum = Vec3::ZERO;
+        match self.light_sampling {
+            LightSampling::PerLight => {
+                for (index, light) in world.scene.lights.iter().enumerate() {
+                    let dimension = dims::LIGHT_POINT + index as u32;
+                    let mut light_sum = Vec3::ZERO;
+                    for k in 0..n {
+                        let y = point_on(light, ctx.point_2d(dimension, k, n));
+                        let Some((contribution, shadow)) = light_sample(&surface, origin, light, y) else { continue };
+                        ctx.rays += 1;
+                        if !world.occluded(&shadow) {
+                            light_sum += contribution;
+                        }
+                    }
+                    sum += light_sum * light.area;
+                }
+            }
+            LightSampling::Power => {
+                let Some(table) = &self.power else { return Vec3::ZERO };
+                for k in 0..n {
+                    let choice = table.sample(ctx.point_1d(dims::LIGHT_CHOICE, k, n));
+                    let light = &world.scene.lights[choice.index];
+                    let y = point_on(light, ctx.point_2d(dims::LIGHT_POINT, k, n));
+                    let Some((contribution, shadow)) = light_sample(&surface, origin, light, y) else { continue };
+                    ctx.rays += 1;
+                    if !world.occluded(&shadow) {
+                        sum += contribution * (light.area / choice.pmf);
+                    }
+                }
+            }
+        }
+        sum * material.kd * (FRAC_1_PI / n as f32)
+    }
+}
