@@ -154,7 +154,7 @@ fn render_with<I: Integrator>(
     let rendered: Vec<(Vec<Vec3>, u64)> = tiles
         .par_iter()
         .map(|tile| {
-            let mut ctx = SampleContext { sampler: &sampler, pixel: 0, sample: 0, rays: 0 };
+            let mut ctx = SampleContext::new(&sampler);
             let mut pixels = Vec::with_capacity(((tile.x1 - tile.x0) * (tile.y1 - tile.y0)) as usize);
             for y in tile.y0..tile.y1 {
                 for x in tile.x0..tile.x1 {

@@ -138,3 +138,63 @@ fn sah_cost_is_sane_and_better_presets_are_not_worse() {
     assert!(costs[1] < indices.len() as f64 / 20.0, "{costs:?}");
     assert!(costs[2] <= costs[0] * 1.02, "high quality {} vs fast {}", costs[2], costs[0]);
 }
+
+/// Shared-origin batches (shafts towards a triangle, hemispheres) answer exactly like traversal
+/// for rays away from triangle edges, and agree on all but a vanishing fraction of edge-grazing rays.
+#[test]
+fn origin_batches_agree_with_traversal() {
+    use lumiere::accel::{OriginBatch, Region};
+    let mut rng = TestRng(77);
+    let (mut rays, mut differ, mut batched) = (0usize, 0usize, 0usize);
+    for mesh_index in 0..120 {
+        let (positions, indices) = random_mesh(&mut rng, 2 + mesh_index % 3);
+        let wide = Bvh4::from_binary(&Bvh::build(&positions, &indices, BuildPreset::Default));
+        let mut batch = OriginBatch::default();
+        for _ in 0..8 {
+            let origin = rng.vec3(-12.0, 12.0);
+            let corners = [rng.vec3(-12.0, 12.0), rng.vec3(-12.0, 12.0), rng.vec3(-12.0, 12.0)];
+            let normal = rng.direction();
+            let (region, shaft) = match Region::shaft(origin, corners) {
+                Some(r) if rng.f32() < 0.5 => (r, true),
+                _ => (Region::hemisphere(origin, normal, f32::INFINITY), false),
+            };
+            batch.prepare(&wide, origin, &region);
+            batched += usize::from(batch.candidate_blocks().is_some());
+            for _ in 0..64 {
+                let ray = if shaft {
+                    let (a, b) = (rng.f32(), rng.f32());
+                    let (a, b) = if a + b > 1.0 { (1.0 - a, 1.0 - b) } else { (a, b) };
+                    let target = corners[0] + a * (corners[1] - corners[0]) + b * (corners[2] - corners[0]);
+                    Ray::segment(origin, target)
+                } else {
+                    let d = rng.direction();
+                    Ray::new(origin, if d.dot(normal) < 0.0 { -d } else { d })
+                };
+                rays += 1;
+                differ += usize::from(batch.occluded(&wide, &ray) != wide.occluded(&ray));
+            }
+        }
+    }
+    assert!(batched > 300, "only {batched} batches used candidates");
+    assert!(differ * 10_000 <= rays, "{differ} of {rays} rays differ");
+}
+
+/// A closed mesh seen from inside: no batched ray escapes, through vertices and edges included.
+#[test]
+fn origin_batches_never_leak_through_a_closed_mesh() {
+    use lumiere::accel::{OriginBatch, Region};
+    let (positions, indices) = grid_cube(2);
+    let wide = Bvh4::from_binary(&Bvh::build(&positions, &indices, BuildPreset::Default));
+    let origin = Vec3::new(0.1, -0.2, 0.05);
+    let mut batch = OriginBatch::default();
+    for normal in [Vec3::X, Vec3::NEG_Y, Vec3::new(0.3, 0.4, -0.5).normalize()] {
+        batch.prepare(&wide, origin, &Region::hemisphere(origin, normal, f32::INFINITY));
+        assert!(batch.candidate_blocks().is_some());
+        for &p in &positions {
+            let dir = p - origin;
+            if dir.dot(normal) > 0.0 {
+                assert!(batch.occluded(&wide, &Ray::new(origin, dir)), "ray to vertex {p:?} escaped");
+            }
+        }
+    }
+}

@@ -281,3 +281,100 @@ fn bad_inputs_give_a_clear_error_and_no_file() {
     }
     assert!(dir.is_empty_but(&["bad_number.obj", "range.obj", "nan.obj", "inf.obj"]));
 }
+
+#[test]
+fn monte_carlo_modes_render_and_are_deterministic() {
+    let dir = TempDir::new("mc");
+    for (mode, extra) in
+        [("direct", &["--sampler", "sobol"][..]), ("ao", &["--spp", "2"][..]), ("ao", &["--ao-distance", "0.3"][..])]
+    {
+        let mut outputs = Vec::new();
+        for threads in ["1", "2"] {
+            let out = dir.path(&format!("{mode}-{threads}.pfm"));
+            let args = [
+                "render",
+                "--mode",
+                mode,
+                "--samples",
+                "8",
+                "--size",
+                "64x48",
+                "--threads",
+                threads,
+                "-o",
+                out.to_str().unwrap(),
+            ];
+            let run = lumiere(&[&args[..], extra].concat());
+            assert!(run.status.success(), "{mode} {extra:?}: {}", stderr(&run));
+            outputs.push(fs::read(&out).unwrap());
+        }
+        assert_eq!(outputs[0], outputs[1], "{mode} {extra:?}: thread count changed the image");
+        let (_, _, px) = read_pfm(&dir.path(&format!("{mode}-1.pfm")));
+        assert!(px.iter().all(|p| p.iter().all(|c| c.is_finite() && *c >= 0.0)));
+        assert!(px.iter().any(|p| p[0] > 0.0), "{mode}: black image");
+    }
+}
+
+#[test]
+fn staircase_emission_turns_many_small_emitters_into_lights() {
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/scenes/staircase/staircase.obj.gz");
+    let dir = TempDir::new("stairs");
+    let out = dir.path("s.pfm");
+    let stats = dir.path("s.json");
+    let camera = [
+        "--eye",
+        "0.0324209,1.52673,4.88197",
+        "--target",
+        "0.0247749,1.571785,3.883015",
+        "--up",
+        "0.000344842,0.998984,0.0450537",
+        "--fov",
+        "58.54",
+    ];
+    let args = [
+        "render",
+        scene,
+        "--mode",
+        "direct",
+        "--light-sampling",
+        "power",
+        "--emission",
+        "Emission=5,5,5",
+        "--samples",
+        "4",
+        "--size",
+        "36x64",
+    ];
+    let run = lumiere(
+        &[&args[..], &camera[..], &["-o", out.to_str().unwrap(), "--stats-json", stats.to_str().unwrap()]].concat(),
+    );
+    assert!(run.status.success(), "{}", stderr(&run));
+    let json: serde_json::Value = serde_json::from_slice(&fs::read(&stats).unwrap()).unwrap();
+    assert!(json["lights"].as_u64().unwrap() > 6000, "lights: {}", json["lights"]);
+    let (_, _, px) = read_pfm(&out);
+    assert!(px.iter().all(|p| p.iter().all(|c| c.is_finite())));
+    assert!(px.iter().filter(|p| p[0] > 0.0).count() > px.len() / 4, "mostly black");
+
+    let unknown = lumiere(&[
+        "render",
+        scene,
+        "--emission",
+        "NoSuchMaterial=1,1,1",
+        "--size",
+        "8x8",
+        "-o",
+        dir.path("u.png").to_str().unwrap(),
+    ]);
+    assert_eq!(unknown.status.code(), Some(2));
+    assert!(stderr(&unknown).contains("NoSuchMaterial"), "{}", stderr(&unknown));
+}
+
+#[test]
+fn lab_bench_quick_prints_every_row() {
+    let run = lumiere(&["bench", "--quick"]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let table = String::from_utf8_lossy(&run.stdout);
+    for row in ["hard shadows", "soft shadows N=16", "soft shadows N=256", "AO N=16", "AO N=256"] {
+        assert!(table.contains(&format!("| {row} |")), "missing {row}:\n{table}");
+    }
+}

@@ -479,3 +479,16 @@ fn samplers_are_decorrelated() {
         }
     }
 }
+
+#[test]
+fn fast_sin_cos_matches_libm() {
+    use lumiere::sampling::warp::sin_cos_turns;
+    let mut worst = 0.0f64;
+    for i in 0..=1_000_000u32 {
+        let t = i as f32 / 1_000_000.0;
+        let (s, c) = sin_cos_turns(t);
+        let angle = t as f64 * std::f64::consts::TAU;
+        worst = worst.max((s as f64 - angle.sin()).abs()).max((c as f64 - angle.cos()).abs());
+    }
+    assert!(worst < 3e-7, "worst error {worst}");
+}

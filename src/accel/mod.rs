@@ -2,6 +2,7 @@
 //! occlusion queries. The BVH knows triangles only as three positions and an id; materials and
 //! lights live elsewhere.
 
+mod batch;
 mod build;
 mod node;
 mod simd;
@@ -10,6 +11,7 @@ mod validate;
 mod wide;
 mod wide_traverse;
 
+pub use batch::{OriginBatch, Region};
 pub use build::BuildPreset;
 pub use node::Node;
 pub use traverse::Hit;

@@ -20,6 +20,40 @@ pub enum Command {
     Info(InfoArgs),
     /// Measure BVH build and traversal on the benchmark scenes (Markdown tables on stdout).
     BenchBvh(BenchBvhArgs),
+    /// Reproduce the lab's timing table on the built-in scene, serial and parallel (Markdown on stdout).
+    Bench(BenchLabArgs),
+    /// Compare the samplers' image error against a converged reference (Markdown on stdout).
+    BenchSampler(BenchSamplerArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct BenchSamplerArgs {
+    /// Image size, WIDTHxHEIGHT.
+    #[arg(long, value_parser = parse_size, default_value = "256x192")]
+    pub size: (u32, u32),
+
+    /// Samples of the converged reference image.
+    #[arg(long, default_value_t = 8192)]
+    pub reference_samples: u32,
+
+    /// Seeds averaged per measurement.
+    #[arg(long, default_value_t = 4)]
+    pub seeds: u64,
+}
+
+#[derive(Args, Debug)]
+pub struct BenchLabArgs {
+    /// Timed renders per row; the median is reported.
+    #[arg(long, default_value_t = 3)]
+    pub repeats: usize,
+
+    /// A reduced run for CI: 256x192, one render per row.
+    #[arg(long)]
+    pub quick: bool,
+
+    /// Also write the table as JSON to this file.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
 }
 
 #[derive(Args, Debug)]

@@ -12,6 +12,7 @@ use lumiere::{Error, Result};
 
 use super::args::BenchBvhArgs;
 use super::export::export_ray_sets;
+use super::pool;
 
 pub fn run(args: &BenchBvhArgs) -> Result<()> {
     let scenes: Vec<BenchScene> = args
@@ -104,11 +105,4 @@ pub fn run(args: &BenchBvhArgs) -> Result<()> {
         write_atomically(path, text.as_bytes())?;
     }
     Ok(())
-}
-
-fn pool(threads: usize) -> Result<rayon::ThreadPool> {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| Error::invalid(format!("cannot start {threads} threads: {e}")))
 }

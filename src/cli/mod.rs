@@ -2,11 +2,13 @@
 
 mod args;
 mod bench_bvh;
+mod bench_lab;
+mod bench_sampler;
 mod export;
 mod info;
 mod render;
 
-use lumiere::Result;
+use lumiere::{Error, Result};
 
 pub use args::Cli;
 use args::Command;
@@ -16,5 +18,15 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Render(args) => render::run(&args),
         Command::Info(args) => info::run(&args),
         Command::BenchBvh(args) => bench_bvh::run(&args),
+        Command::Bench(args) => bench_lab::run(&args),
+        Command::BenchSampler(args) => bench_sampler::run(&args),
     }
+}
+
+/// A rayon pool of `threads` workers (0: one per core).
+fn pool(threads: usize) -> Result<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| Error::invalid(format!("cannot start {threads} threads: {e}")))
 }

@@ -21,10 +21,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if let Some(stats) = &args.stats_json {
         check_writable(stats)?;
     }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads)
-        .build()
-        .map_err(|e| Error::invalid(format!("cannot start {} threads: {e}", args.threads)))?;
+    let pool = super::pool(args.threads)?;
     let threads = pool.current_num_threads();
     pool.install(|| render_in_pool(args, threads))
 }

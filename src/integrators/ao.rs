@@ -1,6 +1,7 @@
 use glam::Vec3;
 
 use super::{Integrator, SampleContext, dims};
+use crate::accel::Region;
 use crate::math::{Frame, Ray, offset_ray_origin};
 use crate::sampling::warp::sample_cosine_hemisphere;
 use crate::world::World;
@@ -23,13 +24,17 @@ impl Integrator for AmbientOcclusion {
         let surface = world.surface(ray, &hit);
         let frame = Frame::from_normal(surface.ng);
         let origin = offset_ray_origin(surface.p, surface.ng);
+        // All probes leave from `origin` into the half-space above the surface: trace them as a batch.
+        let mut batch = std::mem::take(&mut ctx.batch);
+        batch.prepare(&world.bvh, origin, &Region::hemisphere(origin, surface.ng, self.distance));
         let mut visible = 0u32;
         for k in 0..self.samples {
             let local = sample_cosine_hemisphere(ctx.point_2d(dims::HEMISPHERE, k, self.samples));
             let direction = frame.to_world(local);
             let probe = Ray { origin, dir: direction, tmax: self.distance };
-            visible += u32::from(!world.occluded(&probe));
+            visible += u32::from(!batch.occluded(&world.bvh, &probe));
         }
+        ctx.batch = batch;
         ctx.rays += u64::from(self.samples);
         Vec3::splat(visible as f32 / self.samples as f32)
     }

@@ -3,6 +3,7 @@ use std::f32::consts::FRAC_1_PI;
 use glam::Vec3;
 
 use super::{Integrator, SampleContext, dims};
+use crate::accel::Region;
 use crate::lights::AreaLight;
 use crate::math::{Ray, offset_ray_origin};
 use crate::sampling::distrib::AliasTable;
@@ -45,18 +46,28 @@ impl Direct {
 
 /// The unoccluded contribution of the light point `y` to `surface`, divided by the area pdf, and
 /// the shadow segment that decides its visibility; `None` when a cosine is not positive.
+///
+/// `cos(theta) cos(theta_s) / d^2` is evaluated as `(n . v)(-n_s . v) / (v . v)^2` with the
+/// unnormalised `v = y - p`: no square root and one division per sample.
 #[inline(always)]
 fn light_sample(surface: &SurfacePoint, origin: Vec3, light: &AreaLight, y: Vec3) -> Option<(Vec3, Ray)> {
-    let to_light = y - surface.p;
-    let d2 = to_light.length_squared();
-    let wi = to_light / d2.sqrt();
-    let cos_surface = surface.ns.dot(wi);
-    let cos_light = -light.normal.dot(wi);
-    if cos_surface <= 0.0 || cos_light <= 0.0 || surface.ng.dot(wi) <= 0.0 {
+    let v = y - surface.p;
+    let cos_surface = surface.ns.dot(v);
+    let cos_light = -light.normal.dot(v);
+    if cos_surface <= 0.0 || cos_light <= 0.0 || surface.ng.dot(v) <= 0.0 {
         return None;
     }
+    let d2 = v.length_squared();
     let target = offset_ray_origin(y, light.normal);
-    Some((light.emission * (cos_surface * cos_light / d2), Ray::segment(origin, target)))
+    Some((light.emission * (cos_surface * cos_light / (d2 * d2)), Ray::segment(origin, target)))
+}
+
+/// False when no point of the light can contribute: the light lies wholly below the surface's
+/// tangent plane, or the surface lies behind the light. Saves preparing a batch for nothing.
+fn faces_each_other(surface: &SurfacePoint, light: &AreaLight) -> bool {
+    let above = light.vertices.iter().any(|&v| surface.ng.dot(v - surface.p) > 0.0);
+    let in_front = light.normal.dot(surface.p - light.vertices[0]) > 0.0;
+    above && in_front
 }
 
 #[inline(always)]
@@ -80,19 +91,28 @@ impl Integrator for Direct {
         let mut sum = Vec3::ZERO;
         match self.light_sampling {
             LightSampling::PerLight => {
+                // The N shadow rays towards one light triangle share their origin and stay in the shaft
+                // from it to the triangle: trace them as a batch.
+                let mut batch = std::mem::take(&mut ctx.batch);
                 for (index, light) in world.scene.lights.iter().enumerate() {
+                    if !faces_each_other(&surface, light) {
+                        continue;
+                    }
+                    let Some(shaft) = Region::shaft(origin, light.vertices) else { continue };
+                    batch.prepare(&world.bvh, origin, &shaft);
                     let dimension = dims::LIGHT_POINT + index as u32;
                     let mut light_sum = Vec3::ZERO;
                     for k in 0..n {
                         let y = point_on(light, ctx.point_2d(dimension, k, n));
                         let Some((contribution, shadow)) = light_sample(&surface, origin, light, y) else { continue };
                         ctx.rays += 1;
-                        if !world.occluded(&shadow) {
+                        if !batch.occluded(&world.bvh, &shadow) {
                             light_sum += contribution;
                         }
                     }
                     sum += light_sum * light.area;
                 }
+                ctx.batch = batch;
             }
             LightSampling::Power => {
                 let Some(table) = &self.power else { return Vec3::ZERO };

@@ -8,6 +8,7 @@ mod shadows;
 
 use glam::{Vec2, Vec3};
 
+use crate::accel::OriginBatch;
 use crate::math::Ray;
 use crate::sampler::Sampler;
 use crate::world::World;
@@ -62,6 +63,8 @@ pub mod dims {
 #[derive(Debug)]
 pub struct SampleContext<'a> {
     pub sampler: &'a Sampler,
+    /// Reused buffer for shared-origin ray batches (one per thread, never shared).
+    pub batch: OriginBatch,
     /// `y * width + x`.
     pub pixel: u32,
     /// Index of this camera sample within its pixel (0 .. spp).
@@ -69,7 +72,11 @@ pub struct SampleContext<'a> {
     pub rays: u64,
 }
 
-impl SampleContext<'_> {
+impl<'a> SampleContext<'a> {
+    pub fn new(sampler: &'a Sampler) -> Self {
+        SampleContext { sampler, batch: OriginBatch::default(), pixel: 0, sample: 0, rays: 0 }
+    }
+
     /// The `k`-th of `n` 2D points of `dimension` for this camera sample. Consecutive camera samples
     /// own consecutive blocks of `n` indices, so a stratified sampler stratifies across all of them.
     #[inline]

@@ -113,8 +113,28 @@ pub fn invert_uniform_sphere_sample(w: Vec3) -> Vec2 {
 /// The unit vector with polar angle given by its sine and cosine and azimuth `phi`.
 #[inline]
 fn direction(sin_theta: f32, cos_theta: f32, phi: f32) -> Vec3 {
-    let (sin_phi, cos_phi) = phi.sin_cos();
+    let (sin_phi, cos_phi) = sin_cos_turns(phi / TAU);
     Vec3::new(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta)
+}
+
+/// `sin` and `cos` of `2π·turns`, within 3e-8 of the exact values.
+///
+/// libm's `sincosf` took a fifth of ambient-occlusion render time. The angle is reduced to a
+/// quarter turn around the nearest multiple of 90° (|a| ≤ π/4), where Taylor series to `a⁹`/`a⁸`
+/// are accurate to 2e-9/3e-8, and the quadrant rotates the result back.
+#[inline]
+pub fn sin_cos_turns(turns: f32) -> (f32, f32) {
+    let quadrant = (turns * 4.0).round();
+    let a = (turns - quadrant * 0.25) * TAU;
+    let a2 = a * a;
+    let sin = a * (1.0 + a2 * (-1.0 / 6.0 + a2 * (1.0 / 120.0 + a2 * (-1.0 / 5040.0 + a2 * (1.0 / 362_880.0)))));
+    let cos = 1.0 + a2 * (-0.5 + a2 * (1.0 / 24.0 + a2 * (-1.0 / 720.0 + a2 * (1.0 / 40_320.0))));
+    match (quadrant as i32) & 3 {
+        0 => (sin, cos),
+        1 => (cos, -sin),
+        2 => (-sin, -cos),
+        _ => (-cos, sin),
+    }
 }
 
 /// `φ / 2π ∈ [0, 1)` for the azimuth `φ` of `w` around `+z`; 0 on the axis, where `φ` is arbitrary.

@@ -1,0 +1,212 @@
+//! Shared-origin ray batches: many visibility rays leaving one point (the N shadow rays towards one
+//! light triangle, the N ambient-occlusion rays of a hemisphere).
+//!
+//! Once per origin, the BVH is walked with a convex region instead of a ray (the shaft from the
+//! origin to the light triangle, or the half-space above the surface) to gather the few triangles
+//! that can block any ray of the batch. For each of them the Plücker edge vectors
+//! `(vi - o) x (vj - o)` are precomputed; a ray `o + t d` then crosses the triangle iff the three
+//! `d . edge` share a sign, and the distance needs one more dot product. Per ray that is four dot
+//! products per triangle, four triangles per SSE operation, and no traversal at all.
+//!
+//! Watertight like the Woop test: the two triangles sharing an edge compute its vector from the
+//! same two corner vectors in swapped order, so one is exactly the negation of the other and a ray
+//! through the edge is accepted by at least one of them. When the region holds too many triangles
+//! (large scenes, wide hemispheres), the batch falls back to ordinary traversal for each ray.
+
+use glam::{Vec3, Vec4};
+
+use super::simd::F32x4;
+use super::wide::{Bvh4, LEAF_BIT, leaf_blocks};
+use crate::math::Ray;
+
+/// Beyond this many candidate blocks (of four triangles), per-ray traversal is cheaper.
+const MAX_CANDIDATE_BLOCKS: usize = 24;
+
+/// Four candidate triangles, SoA: the three Plücker edge vectors and the plane (normal, and the
+/// normal's dot product with the first corner relative to the origin).
+#[derive(Clone, Copy, Debug)]
+struct PluckerBlock {
+    edges: [[[f32; 4]; 3]; 3],
+    normal: [[f32; 4]; 3],
+    plane_offset: [f32; 4],
+    /// Roughly the solid angle the four triangles cover, seen from the origin (for ordering only).
+    solid_angle: f32,
+}
+
+/// A convex region of space, `n . x + d >= 0` for every plane, that contains every ray of a batch.
+#[derive(Clone, Copy, Debug)]
+pub struct Region {
+    planes: [Vec4; 4],
+    count: usize,
+    /// Boxes are kept unless outside a plane by more than this (absorbs the few-ulp offsets of ray
+    /// ends and the rounding of the plane equations).
+    tolerance: f32,
+}
+
+impl Region {
+    /// The tetrahedron spanned by `origin` and the triangle `corners` (the shaft of all segments
+    /// from the origin to points of the triangle).
+    pub fn shaft(origin: Vec3, corners: [Vec3; 3]) -> Option<Region> {
+        let centroid = (origin + corners[0] + corners[1] + corners[2]) * 0.25;
+        let faces = [
+            [origin, corners[0], corners[1]],
+            [origin, corners[1], corners[2]],
+            [origin, corners[2], corners[0]],
+            [corners[0], corners[1], corners[2]],
+        ];
+        let size = corners.iter().map(|c| (*c - origin).length()).fold(0.0f32, f32::max);
+        let mut planes = [Vec4::ZERO; 4];
+        for (plane, [a, b, c]) in planes.iter_mut().zip(faces) {
+            let n = (b - a).cross(c - a).try_normalize()?;
+            let n = if n.dot(centroid - a) < 0.0 { -n } else { n };
+            *plane = n.extend(-n.dot(a));
+        }
+        Some(Region { planes, count: 4, tolerance: tolerance(origin, size) })
+    }
+
+    /// The half-space on the side `normal` points to, cut to a cube of half-size `distance`
+    /// around `origin` when the distance is finite.
+    pub fn hemisphere(origin: Vec3, normal: Vec3, distance: f32) -> Region {
+        let n = normal.normalize();
+        let mut planes = [Vec4::ZERO; 4];
+        planes[0] = n.extend(-n.dot(origin));
+        Region { planes, count: 1, tolerance: tolerance(origin, if distance.is_finite() { distance } else { 0.0 }) }
+    }
+
+    fn contains_box(&self, node_bounds: &[[f32; 4]; 6]) -> u32 {
+        let mut inside = 0xF;
+        for plane in &self.planes[..self.count] {
+            // The corner of each box farthest along the plane normal.
+            let far = |axis: usize| {
+                let row = if plane[axis] >= 0.0 { axis + 3 } else { axis };
+                F32x4::load(&node_bounds[row]) * F32x4::splat(plane[axis])
+            };
+            let distance = far(0) + far(1) + far(2) + F32x4::splat(plane.w);
+            inside &= distance.gt(F32x4::splat(-self.tolerance)).bits();
+        }
+        inside
+    }
+}
+
+/// A few thousand ulps of the region's coordinates: far above rounding, far below any geometry.
+fn tolerance(origin: Vec3, size: f32) -> f32 {
+    4096.0 * f32::EPSILON * (origin.abs().max_element() + size)
+}
+
+/// Candidate triangles for rays from one origin, or a note to traverse the BVH per ray. Keep one
+/// per thread and `prepare` it for each origin: its buffer is reused.
+#[derive(Clone, Debug, Default)]
+pub struct OriginBatch {
+    origin: Vec3,
+    blocks: Vec<PluckerBlock>,
+    traverse: bool,
+}
+
+impl OriginBatch {
+    /// Gathers the triangles of `bvh` that may block rays from `origin` within `region`.
+    pub fn prepare(&mut self, bvh: &Bvh4, origin: Vec3, region: &Region) {
+        self.origin = origin;
+        self.blocks.clear();
+        self.traverse = false;
+        if bvh.triangle_count() == 0 {
+            return;
+        }
+        // Depth-first walk of the region; a wide level pushes at most four children.
+        let mut stack = [0u32; 4 * super::build::MAX_DEPTH + 1];
+        let mut len = 1;
+        while len > 0 {
+            len -= 1;
+            let reference = stack[len];
+            if reference & LEAF_BIT != 0 {
+                for block in &bvh.blocks[leaf_blocks(reference)] {
+                    if self.blocks.len() == MAX_CANDIDATE_BLOCKS {
+                        self.traverse = true;
+                        self.blocks.clear();
+                        return;
+                    }
+                    self.blocks.push(plucker_block(origin, &block.vertices));
+                }
+                continue;
+            }
+            let node = &bvh.nodes[reference as usize];
+            let mut mask = region.contains_box(&node.bounds);
+            while mask != 0 {
+                let slot = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                stack[len] = node.children[slot];
+                len += 1;
+            }
+        }
+        self.order_by_solid_angle();
+    }
+
+    /// Candidate blocks gathered, and whether rays fall back to traversal (for tests and tuning).
+    pub fn candidate_blocks(&self) -> Option<usize> {
+        (!self.traverse).then_some(self.blocks.len())
+    }
+
+    /// Puts the blocks that cover the most solid angle first, so that an any-hit query over many
+    /// random directions (ambient occlusion in a closed room) usually stops at the first block.
+    fn order_by_solid_angle(&mut self) {
+        self.blocks.sort_by(|a, b| b.solid_angle.total_cmp(&a.solid_angle));
+    }
+
+    /// True if the ray (which must leave from the prepared origin, inside the region) is blocked
+    /// with `t` in `(0, ray.tmax]`.
+    #[inline]
+    pub fn occluded(&self, bvh: &Bvh4, ray: &Ray) -> bool {
+        debug_assert_eq!(ray.origin, self.origin);
+        if self.traverse {
+            return bvh.occluded(ray);
+        }
+        let d = ray.dir.to_array().map(F32x4::splat);
+        let zero = F32x4::splat(0.0);
+        let tmax = F32x4::splat(ray.tmax);
+        self.blocks.iter().any(|block| {
+            let dot =
+                |v: &[[f32; 4]; 3]| d[0] * F32x4::load(&v[0]) + d[1] * F32x4::load(&v[1]) + d[2] * F32x4::load(&v[2]);
+            let (s0, s1, s2) = (dot(&block.edges[0]), dot(&block.edges[1]), dot(&block.edges[2]));
+            let negative = s0.lt(zero) | s1.lt(zero) | s2.lt(zero);
+            let positive = s0.gt(zero) | s1.gt(zero) | s2.gt(zero);
+            // Same sign on all three edges, and not all zero (a ray in the triangle's plane).
+            let crosses = !(negative.bits() & positive.bits()) & (negative | positive).bits();
+            if crosses == 0 {
+                return false;
+            }
+            // t = plane_offset / (d . n), accepted in (0, tmax] without dividing.
+            let denominator = dot(&block.normal);
+            let numerator = F32x4::load(&block.plane_offset);
+            let ahead = (numerator * denominator).gt(zero);
+            let within = numerator.abs().le(tmax * denominator.abs());
+            crosses & (ahead.bits() & within.bits()) != 0
+        })
+    }
+}
+
+/// Edge vectors and plane of four triangles relative to `origin`.
+#[expect(clippy::needless_range_loop, reason = "one SoA lane index addresses several arrays")]
+fn plucker_block(origin: Vec3, vertices: &[[[f32; 4]; 3]; 3]) -> PluckerBlock {
+    let mut block =
+        PluckerBlock { edges: [[[0.0; 4]; 3]; 3], normal: [[0.0; 4]; 3], plane_offset: [0.0; 4], solid_angle: 0.0 };
+    for lane in 0..4 {
+        let corner = |c: usize| Vec3::new(vertices[c][0][lane], vertices[c][1][lane], vertices[c][2][lane]);
+        let (p0, p1, p2) = (corner(0), corner(1), corner(2));
+        let (a, b, c) = (p0 - origin, p1 - origin, p2 - origin);
+        let edges = [b.cross(c), c.cross(a), a.cross(b)];
+        let normal = (p1 - p0).cross(p2 - p0);
+        for axis in 0..3 {
+            for (e, edge) in edges.iter().enumerate() {
+                block.edges[e][axis][lane] = edge[axis];
+            }
+            block.normal[axis][lane] = normal[axis];
+        }
+        block.plane_offset[lane] = a.dot(normal);
+        // Projected area over squared distance: |n . (c - o)| / |c - o|^3 with |n| = twice the area.
+        let to_centroid = (a + b + c) / 3.0;
+        let distance = to_centroid.length().max(f32::MIN_POSITIVE);
+        let projected = normal.dot(to_centroid).abs() / (distance * distance * distance);
+        // Duplicated padding lanes repeat the last triangle; counting them twice only affects order.
+        block.solid_angle += if projected.is_finite() { projected } else { f32::MAX };
+    }
+    block
+}
