@@ -22,7 +22,10 @@
 
 pub mod accel;
 pub mod bench;
+pub mod checkpoint;
 pub mod error;
+pub mod film;
+pub mod fingerprint;
 pub mod geometry;
 pub mod image_io;
 pub mod integrators;

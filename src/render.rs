@@ -1,12 +1,16 @@
-//! Tiles of pixels scheduled with rayon; each pixel's value depends only on the pixel and the
-//! options, never on which thread ran it, so images are identical for any thread count.
+//! Progressive rendering: passes of one camera sample per pixel over the whole image, each pass
+//! split into tiles scheduled with rayon. A pixel's samples depend only on the pixel, the sample
+//! index and the options, never on the thread that ran them, and passes are accumulated in order,
+//! so images are identical for any thread count and for any stopping point.
 
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
+use crate::film::Film;
 use crate::integrators::{
     AmbientOcclusion, Direct, Hits, Integrator, LightSampling, Materials, Mode, SampleContext, Shadows, dims,
 };
@@ -14,8 +18,8 @@ use crate::sampler::{Sampler, SamplerKind};
 use crate::scene::camera::Camera;
 use crate::world::World;
 
-/// Tiles are small enough to balance two cores on a 1024x768 image and large enough that
-/// scheduling costs nothing.
+/// Tiles are small enough to balance two cores and to notice an interruption within milliseconds,
+/// and large enough that scheduling costs nothing.
 const TILE_SIZE: u32 = 16;
 
 #[derive(Clone, Debug, PartialEq)]
@@ -23,18 +27,22 @@ pub struct RenderOptions {
     pub mode: Mode,
     /// Samples per light (or in total, with power light sampling) or per hemisphere.
     pub samples: u32,
-    /// Camera samples per pixel; 1 is the lab's single ray through the pixel centre, more are
-    /// jittered inside the pixel.
+    /// Camera samples per pixel to reach; 1 is the lab's single ray through the pixel centre,
+    /// more are jittered inside the pixel.
     pub spp: u32,
     pub seed: u64,
     pub sampler: SamplerKind,
     pub light_sampling: LightSampling,
     /// Ambient occlusion rays stop at this distance (infinite: visibility of the sky).
     pub ao_distance: f32,
+    /// Stop after the pass that crosses this much rendering time.
+    pub time_budget: Option<Duration>,
+    /// Stop once the image's estimated relative standard error is below this.
+    pub noise_target: Option<f64>,
 }
 
 impl RenderOptions {
-    /// The options of a lab image: one camera ray per pixel centre, independent samples.
+    /// The options of a lab image: one camera ray per pixel centre, independent samples, no budget.
     pub fn new(mode: Mode, samples: u32) -> Self {
         RenderOptions {
             mode,
@@ -44,7 +52,28 @@ impl RenderOptions {
             sampler: SamplerKind::Independent,
             light_sampling: LightSampling::PerLight,
             ao_distance: f32::INFINITY,
+            time_budget: None,
+            noise_target: None,
         }
+    }
+
+    fn validate(&self, camera: &Camera) -> Result<()> {
+        if camera.width == 0 || camera.height == 0 {
+            return Err(Error::invalid(format!("image size {}x{} has no pixels", camera.width, camera.height)));
+        }
+        if self.samples == 0 {
+            return Err(Error::invalid("--samples must be at least 1"));
+        }
+        if self.spp == 0 {
+            return Err(Error::invalid("--spp must be at least 1"));
+        }
+        if self.ao_distance.is_nan() || self.ao_distance <= 0.0 {
+            return Err(Error::invalid(format!("--ao-distance must be positive, got {}", self.ao_distance)));
+        }
+        if self.noise_target.is_some_and(|n| n.is_nan() || n <= 0.0) {
+            return Err(Error::invalid("--noise must be positive"));
+        }
+        Ok(())
     }
 }
 
@@ -56,18 +85,194 @@ pub struct Image {
     pub pixels: Vec<Vec3>,
 }
 
+/// Why a render stopped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StopReason {
+    /// Every pixel has the requested samples.
+    Completed,
+    TimeBudget,
+    NoiseTarget,
+    /// Cancelled (Ctrl-C); the pass in flight was abandoned.
+    Interrupted,
+}
+
+impl StopReason {
+    pub fn describe(self) -> &'static str {
+        match self {
+            StopReason::Completed => "all samples done",
+            StopReason::TimeBudget => "time budget reached",
+            StopReason::NoiseTarget => "noise target reached",
+            StopReason::Interrupted => "interrupted",
+        }
+    }
+}
+
+/// Totals of a render, carried across checkpoints.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RenderStats {
+    /// Every ray traced: camera rays and visibility queries.
+    pub rays: u64,
+    /// Rendering time, summed over the sessions of a resumed render.
+    pub elapsed: Duration,
+}
+
+impl RenderStats {
+    pub fn mrays_per_second(&self) -> f64 {
+        self.rays as f64 / self.elapsed.as_secs_f64().max(1e-9) / 1e6
+    }
+}
+
 #[derive(Clone, Debug)]
 pub struct RenderOutput {
     pub image: Image,
-    /// Every ray traced: camera rays and shadow rays.
-    pub rays: u64,
-    pub elapsed: Duration,
+    pub film: Film,
+    pub stats: RenderStats,
+    pub stop: StopReason,
 }
 
 impl RenderOutput {
     pub fn mrays_per_second(&self) -> f64 {
-        self.rays as f64 / self.elapsed.as_secs_f64().max(1e-9) / 1e6
+        self.stats.mrays_per_second()
     }
+}
+
+/// What the caller can watch and steer during a progressive render.
+pub struct Hooks<'a> {
+    /// Called after each tile with the number of pixel samples it added.
+    pub progress: &'a (dyn Fn(u64) + Sync),
+    /// Called after each completed pass (previews, checkpoints); an error stops the render.
+    pub pass_done: &'a mut dyn FnMut(&Film, &RenderStats) -> Result<()>,
+    /// Set from another thread (a signal handler) to stop; the pass in flight is abandoned.
+    pub cancel: &'a AtomicBool,
+}
+
+/// Renders `options.spp` samples per pixel on the current rayon pool, without hooks.
+pub fn render(
+    world: &World,
+    camera: &Camera,
+    options: &RenderOptions,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<RenderOutput> {
+    let film = Film::new(camera.width, camera.height)?;
+    let cancel = AtomicBool::new(false);
+    let hooks = Hooks { progress, pass_done: &mut |_, _| Ok(()), cancel: &cancel };
+    render_progressive(world, camera, options, film, RenderStats::default(), hooks)
+}
+
+/// Continues `film` (new, or resumed from a checkpoint with its `stats`) pass by pass until it has
+/// `options.spp` samples, a budget is reached or `hooks.cancel` is set.
+pub fn render_progressive(
+    world: &World,
+    camera: &Camera,
+    options: &RenderOptions,
+    film: Film,
+    stats: RenderStats,
+    hooks: Hooks,
+) -> Result<RenderOutput> {
+    options.validate(camera)?;
+    if (film.width, film.height) != (camera.width, camera.height) {
+        return Err(Error::invalid(format!(
+            "film is {}x{} but the camera is {}x{}",
+            film.width, film.height, camera.width, camera.height
+        )));
+    }
+    let n = options.samples;
+    match options.mode {
+        Mode::Hits => run_passes(&Hits, world, camera, options, film, stats, hooks),
+        Mode::Materials => run_passes(&Materials, world, camera, options, film, stats, hooks),
+        Mode::Shadows => run_passes(&Shadows, world, camera, options, film, stats, hooks),
+        Mode::Direct => {
+            run_passes(&Direct::new(world, n, options.light_sampling), world, camera, options, film, stats, hooks)
+        }
+        Mode::AmbientOcclusion => {
+            let ao = AmbientOcclusion { samples: n, distance: options.ao_distance };
+            run_passes(&ao, world, camera, options, film, stats, hooks)
+        }
+    }
+}
+
+fn run_passes<I: Integrator>(
+    integrator: &I,
+    world: &World,
+    camera: &Camera,
+    options: &RenderOptions,
+    mut film: Film,
+    mut stats: RenderStats,
+    hooks: Hooks,
+) -> Result<RenderOutput> {
+    let start = Instant::now();
+    let before = stats.elapsed;
+    let sampler = Sampler::new(options.sampler, options.seed);
+    let tiles = tiles(camera.width, camera.height);
+    let stop = loop {
+        if film.samples >= options.spp {
+            break StopReason::Completed;
+        }
+        let Some(pass) = render_pass(integrator, world, camera, &sampler, &tiles, film.samples, options.spp, &hooks)
+        else {
+            break StopReason::Interrupted;
+        };
+        for (tile, (values, rays)) in tiles.iter().zip(pass) {
+            film.add_tile(tile.x0, tile.y0, tile.x1 - tile.x0, &values);
+            stats.rays += rays;
+        }
+        film.samples += 1;
+        stats.elapsed = before + start.elapsed();
+        (hooks.pass_done)(&film, &stats)?;
+        if film.samples >= options.spp {
+            break StopReason::Completed;
+        }
+        if options.time_budget.is_some_and(|budget| start.elapsed() >= budget) {
+            break StopReason::TimeBudget;
+        }
+        if let (Some(target), Some(error)) = (options.noise_target, film.relative_error())
+            && error <= target
+        {
+            break StopReason::NoiseTarget;
+        }
+        if hooks.cancel.load(Ordering::Relaxed) {
+            break StopReason::Interrupted;
+        }
+    };
+    stats.elapsed = before + start.elapsed();
+    Ok(RenderOutput { image: film.image(), film, stats, stop })
+}
+
+/// One sample per pixel (sample index `sample`): per tile, its values row by row and its rays;
+/// `None` if cancelled before the pass completed.
+#[expect(clippy::too_many_arguments, reason = "the pass's whole context, passed once per pass")]
+fn render_pass<I: Integrator>(
+    integrator: &I,
+    world: &World,
+    camera: &Camera,
+    sampler: &Sampler,
+    tiles: &[Tile],
+    sample: u32,
+    spp: u32,
+    hooks: &Hooks,
+) -> Option<Vec<(Vec<Vec3>, u64)>> {
+    tiles
+        .par_iter()
+        .map(|tile| {
+            if hooks.cancel.load(Ordering::Relaxed) {
+                return None;
+            }
+            let mut ctx = SampleContext::new(sampler);
+            ctx.sample = sample;
+            let mut values = Vec::with_capacity(((tile.x1 - tile.x0) * (tile.y1 - tile.y0)) as usize);
+            for y in tile.y0..tile.y1 {
+                for x in tile.x0..tile.x1 {
+                    ctx.pixel = y * camera.width + x;
+                    // One sample: the pixel centre, as the lab did; more: jittered in the pixel.
+                    let offset = if spp == 1 { glam::Vec2::splat(0.5) } else { ctx.point_2d(dims::PIXEL, 0, 1) };
+                    let ray = camera.ray(x as f32 + offset.x, y as f32 + offset.y);
+                    values.push(integrator.radiance(world, &ray, &mut ctx));
+                }
+            }
+            (hooks.progress)(values.len() as u64);
+            Some((values, ctx.rays))
+        })
+        .collect()
 }
 
 #[derive(Clone, Copy)]
@@ -86,96 +291,4 @@ fn tiles(width: u32, height: u32) -> Vec<Tile> {
         }
     }
     out
-}
-
-/// Renders on the current rayon pool; `progress(pixels_done)` is called after each tile.
-pub fn render(
-    world: &World,
-    camera: &Camera,
-    options: &RenderOptions,
-    progress: &(dyn Fn(u64) + Sync),
-) -> Result<RenderOutput> {
-    if camera.width == 0 || camera.height == 0 {
-        return Err(Error::invalid(format!("image size {}x{} has no pixels", camera.width, camera.height)));
-    }
-    if options.samples == 0 {
-        return Err(Error::invalid("--samples must be at least 1"));
-    }
-    if options.spp == 0 {
-        return Err(Error::invalid("--spp must be at least 1"));
-    }
-    if options.ao_distance.is_nan() || options.ao_distance <= 0.0 {
-        return Err(Error::invalid(format!("--ao-distance must be positive, got {}", options.ao_distance)));
-    }
-    let n = options.samples;
-    Ok(match options.mode {
-        Mode::Hits => render_with(&Hits, world, camera, options, progress),
-        Mode::Materials => render_with(&Materials, world, camera, options, progress),
-        Mode::Shadows => render_with(&Shadows, world, camera, options, progress),
-        Mode::Direct => render_with(&Direct::new(world, n, options.light_sampling), world, camera, options, progress),
-        Mode::AmbientOcclusion => {
-            let ao = AmbientOcclusion { samples: n, distance: options.ao_distance };
-            render_with(&ao, world, camera, options, progress)
-        }
-    })
-}
-
-/// The estimate of pixel `(x, y)`: the mean over its camera samples.
-#[inline]
-fn render_pixel<I: Integrator>(
-    integrator: &I,
-    world: &World,
-    camera: &Camera,
-    spp: u32,
-    (x, y): (u32, u32),
-    ctx: &mut SampleContext,
-) -> Vec3 {
-    ctx.pixel = y * camera.width + x;
-    let mut sum = Vec3::ZERO;
-    for sample in 0..spp {
-        ctx.sample = sample;
-        let offset = if spp == 1 { glam::Vec2::splat(0.5) } else { ctx.point_2d(dims::PIXEL, 0, 1) };
-        let ray = camera.ray(x as f32 + offset.x, y as f32 + offset.y);
-        sum += integrator.radiance(world, &ray, ctx);
-    }
-    sum / spp as f32
-}
-
-fn render_with<I: Integrator>(
-    integrator: &I,
-    world: &World,
-    camera: &Camera,
-    options: &RenderOptions,
-    progress: &(dyn Fn(u64) + Sync),
-) -> RenderOutput {
-    let start = Instant::now();
-    let sampler = Sampler::new(options.sampler, options.seed);
-    let tiles = tiles(camera.width, camera.height);
-    let rendered: Vec<(Vec<Vec3>, u64)> = tiles
-        .par_iter()
-        .map(|tile| {
-            let mut ctx = SampleContext::new(&sampler);
-            let mut pixels = Vec::with_capacity(((tile.x1 - tile.x0) * (tile.y1 - tile.y0)) as usize);
-            for y in tile.y0..tile.y1 {
-                for x in tile.x0..tile.x1 {
-                    pixels.push(render_pixel(integrator, world, camera, options.spp, (x, y), &mut ctx));
-                }
-            }
-            progress(pixels.len() as u64);
-            (pixels, ctx.rays)
-        })
-        .collect();
-
-    let (width, height) = (camera.width, camera.height);
-    let mut image = Image { width, height, pixels: vec![Vec3::ZERO; width as usize * height as usize] };
-    let mut rays = 0;
-    for (tile, (pixels, tile_rays)) in tiles.iter().zip(rendered) {
-        rays += tile_rays;
-        let tile_width = (tile.x1 - tile.x0) as usize;
-        for (row, chunk) in pixels.chunks_exact(tile_width).enumerate() {
-            let start = (tile.y0 as usize + row) * width as usize + tile.x0 as usize;
-            image.pixels[start..start + tile_width].copy_from_slice(chunk);
-        }
-    }
-    RenderOutput { image, rays, elapsed: start.elapsed() }
 }

@@ -213,6 +213,30 @@ pub struct RenderArgs {
     /// Write render statistics (mode, size, rays, timings) as JSON to this file.
     #[arg(long)]
     pub stats_json: Option<PathBuf>,
+
+    /// Stop after the pass that crosses this rendering time (e.g. 30s, 5m, 1h, 1.5s).
+    #[arg(long, value_parser = parse_duration)]
+    pub time: Option<std::time::Duration>,
+
+    /// Stop once the estimated relative standard error of the image is below this (e.g. 0.01).
+    #[arg(long)]
+    pub noise: Option<f64>,
+
+    /// Rewrite the output image with the current estimate every SECONDS (atomically).
+    #[arg(long)]
+    pub preview_every: Option<f64>,
+
+    /// Save the accumulation state to this file after passes (atomically), for --resume.
+    #[arg(long)]
+    pub checkpoint: Option<PathBuf>,
+
+    /// Seconds between checkpoints; 0 saves after every pass.
+    #[arg(long, default_value_t = 0.0)]
+    pub checkpoint_every: f64,
+
+    /// Continue the render saved in this checkpoint (same scene and options; --spp may grow).
+    #[arg(long)]
+    pub resume: Option<PathBuf>,
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -223,6 +247,20 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
         return Err(format!("image size {w}x{h} has no pixels"));
     }
     Ok((w, h))
+}
+
+fn parse_duration(s: &str) -> Result<std::time::Duration, String> {
+    let s = s.trim();
+    let (number, unit) = s.split_at(s.find(|c: char| c.is_ascii_alphabetic()).unwrap_or(s.len()));
+    let value: f64 = number.trim().parse().map_err(|_| format!("expected a duration like 30s, 5m or 1h, got '{s}'"))?;
+    let seconds = match unit {
+        "" | "s" => value,
+        "ms" => value / 1e3,
+        "m" | "min" => value * 60.0,
+        "h" => value * 3600.0,
+        _ => return Err(format!("unknown time unit '{unit}' (use ms, s, m or h)")),
+    };
+    std::time::Duration::try_from_secs_f64(seconds).map_err(|_| format!("'{s}' is not a valid duration"))
 }
 
 fn parse_emission(s: &str) -> Result<(String, Vec3), String> {

@@ -89,7 +89,7 @@ pub fn run(args: &BenchLabArgs) -> Result<()> {
             let mut failure = None;
             let seconds = pool.install(|| {
                 median_seconds(repeats, || match render(&world, &camera, &options, &|_| {}) {
-                    Ok(out) => rays = out.rays,
+                    Ok(out) => rays = out.stats.rays,
                     Err(e) => failure = Some(e),
                 })
             });

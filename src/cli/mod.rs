@@ -13,13 +13,14 @@ use lumiere::{Error, Result};
 pub use args::Cli;
 use args::Command;
 
-pub fn run(cli: Cli) -> Result<()> {
+/// Runs a subcommand; returns the process exit code on success.
+pub fn run(cli: Cli) -> Result<u8> {
     match cli.command {
         Command::Render(args) => render::run(&args),
-        Command::Info(args) => info::run(&args),
-        Command::BenchBvh(args) => bench_bvh::run(&args),
-        Command::Bench(args) => bench_lab::run(&args),
-        Command::BenchSampler(args) => bench_sampler::run(&args),
+        Command::Info(args) => info::run(&args).map(|()| 0),
+        Command::BenchBvh(args) => bench_bvh::run(&args).map(|()| 0),
+        Command::Bench(args) => bench_lab::run(&args).map(|()| 0),
+        Command::BenchSampler(args) => bench_sampler::run(&args).map(|()| 0),
     }
 }
 
