@@ -2,39 +2,11 @@
 //! counts, statistics, and a clear error (exit code 2, no output file) for every bad input.
 
 use std::fs;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
 
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(name: &str) -> TempDir {
-        let dir = std::env::temp_dir().join(format!("lumiere-cli-{name}-{}", std::process::id()));
-        let _ = fs::remove_dir_all(&dir);
-        fs::create_dir_all(&dir).unwrap();
-        TempDir(dir)
-    }
-
-    fn path(&self, name: &str) -> PathBuf {
-        self.0.join(name)
-    }
-
-    fn write(&self, name: &str, content: &str) -> PathBuf {
-        let path = self.path(name);
-        fs::write(&path, content).unwrap();
-        path
-    }
-
-    fn is_empty_but(&self, keep: &[&str]) -> bool {
-        fs::read_dir(&self.0).unwrap().all(|e| keep.contains(&e.unwrap().file_name().to_str().unwrap()))
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = fs::remove_dir_all(&self.0);
-    }
-}
+mod common;
+use common::TempDir;
 
 fn lumiere(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_lumiere")).args(args).output().expect("the binary runs")
@@ -279,7 +251,7 @@ fn bad_inputs_give_a_clear_error_and_no_file() {
         assert!(stderr(&run).contains(expected), "{}", stderr(&run));
         assert!(!Path::new(path).exists());
     }
-    assert!(dir.is_empty_but(&["bad_number.obj", "range.obj", "nan.obj", "inf.obj"]));
+    assert_eq!(dir.entries(), ["bad_number.obj", "inf.obj", "nan.obj", "range.obj"]);
 }
 
 #[test]

@@ -2,43 +2,13 @@
 //! writes are atomic (old content fully replaced, nothing left behind on success or failure).
 
 use std::fs;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use glam::Vec3;
+mod common;
+use common::TempDir;
 use lumiere::Error;
 use lumiere::image_io::{PngEncoding, check_output_path, linear_to_srgb8, write_atomically, write_image};
-
-/// A fresh directory under the system temp dir, removed when dropped (no tempfile crate).
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(name: &str) -> Self {
-        let dir = std::env::temp_dir().join(format!("lumiere-image-io-{}-{name}", std::process::id()));
-        let _ = fs::remove_dir_all(&dir);
-        fs::create_dir_all(&dir).expect("create test dir");
-        TempDir(dir)
-    }
-
-    fn join(&self, name: &str) -> PathBuf {
-        self.0.join(name)
-    }
-
-    /// Names of everything in the directory, sorted, to catch stray temp files.
-    fn entries(&self) -> Vec<String> {
-        let mut names: Vec<String> = fs::read_dir(&self.0)
-            .expect("read test dir")
-            .map(|e| e.expect("dir entry").file_name().to_string_lossy().into_owned())
-            .collect();
-        names.sort();
-        names
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = fs::remove_dir_all(&self.0);
-    }
-}
 
 /// The reference: IEC 61966-2-1 in f64, rounded to nearest.
 fn srgb8_exact(c: f32) -> u8 {
@@ -71,7 +41,7 @@ fn assert_invalid(result: lumiere::Result<()>, needle: &str) {
 #[test]
 fn png_srgb_round_trip_values_and_row_order() {
     let dir = TempDir::new("png-srgb");
-    let path = dir.join("out.png");
+    let path = dir.path("out.png");
     let boundary = 0.0031308_f32;
     let top = [g(0.0), g(1.0), g(0.5), g(boundary)];
     let bottom = [
@@ -100,7 +70,7 @@ fn png_srgb_round_trip_values_and_row_order() {
 #[test]
 fn png_gkit_linear_truncates_without_gamma() {
     let dir = TempDir::new("png-gkit");
-    let path = dir.join("gkit.PNG");
+    let path = dir.path("gkit.PNG");
     let pixels = [g(0.5), g(0.999), g(1.0), g(2.0), Vec3::new(f32::NAN, f32::INFINITY, -0.5)];
     write_image(&path, 5, 1, &pixels, PngEncoding::GkitLinear).expect("write png");
 
@@ -113,7 +83,7 @@ fn png_gkit_linear_truncates_without_gamma() {
 #[test]
 fn exr_round_trip_is_bit_exact_and_top_down() {
     let dir = TempDir::new("exr");
-    let path = dir.join("out.Exr");
+    let path = dir.path("out.Exr");
     let (w, h) = (3usize, 2usize);
     let pixels = [
         Vec3::new(0.0, 1.0, 0.5),
@@ -147,7 +117,7 @@ fn exr_round_trip_is_bit_exact_and_top_down() {
 #[test]
 fn pfm_round_trip_rows_bottom_to_top() {
     let dir = TempDir::new("pfm");
-    let path = dir.join("out.pfm");
+    let path = dir.path("out.pfm");
     let (w, h) = (2usize, 3usize);
     let pixels: Vec<Vec3> = (0..w * h).map(|i| Vec3::new(i as f32, -(i as f32) * 0.5, 1e-3 * i as f32)).collect();
     let mut with_specials = pixels.clone();
@@ -173,7 +143,7 @@ fn pfm_round_trip_rows_bottom_to_top() {
 fn unknown_or_missing_extension_is_invalid_and_writes_nothing() {
     let dir = TempDir::new("ext");
     for name in ["out.jpg", "out", "out.png.bak"] {
-        let path = dir.join(name);
+        let path = dir.path(name);
         let result = write_image(&path, 1, 1, &[g(0.5)], PngEncoding::Srgb);
         assert_invalid(result, ".png, .exr, .pfm");
         assert_invalid(check_output_path(&path), ".png, .exr, .pfm");
@@ -184,7 +154,7 @@ fn unknown_or_missing_extension_is_invalid_and_writes_nothing() {
 #[test]
 fn wrong_pixel_count_or_zero_size_is_invalid() {
     let dir = TempDir::new("dims");
-    let path = dir.join("out.png");
+    let path = dir.path("out.png");
     assert_invalid(write_image(&path, 2, 2, &[g(0.0); 3], PngEncoding::Srgb), "3 pixels");
     assert_invalid(write_image(&path, 0, 2, &[], PngEncoding::Srgb), "zero");
     assert_invalid(write_image(&path, 2, 0, &[], PngEncoding::Srgb), "zero");
@@ -194,7 +164,7 @@ fn wrong_pixel_count_or_zero_size_is_invalid() {
 #[test]
 fn missing_directory_is_an_io_error_naming_the_path_and_leaves_nothing() {
     let dir = TempDir::new("missing");
-    let path = dir.join("no/such/dir/out.exr");
+    let path = dir.path("no/such/dir/out.exr");
     assert_io_error(write_image(&path, 1, 1, &[g(1.0)], PngEncoding::Srgb), &path);
     assert_io_error(write_atomically(&path, b"bytes"), &path);
     assert_io_error(check_output_path(&path), &path);
@@ -204,12 +174,12 @@ fn missing_directory_is_an_io_error_naming_the_path_and_leaves_nothing() {
 #[test]
 fn overwrite_replaces_old_content_fully() {
     let dir = TempDir::new("overwrite");
-    let path = dir.join("stats.json");
+    let path = dir.path("stats.json");
     write_atomically(&path, &vec![b'x'; 100_000]).expect("first write");
     write_atomically(&path, b"{}").expect("second write");
     assert_eq!(fs::read(&path).expect("read back"), b"{}");
 
-    let image = dir.join("img.pfm");
+    let image = dir.path("img.pfm");
     fs::write(&image, vec![0u8; 10_000]).expect("old image");
     write_image(&image, 1, 1, &[g(2.0)], PngEncoding::Srgb).expect("overwrite image");
     let mut expected = b"PF\n1 1\n-1.0\n".to_vec();
@@ -222,7 +192,7 @@ fn overwrite_replaces_old_content_fully() {
 fn failed_rename_removes_the_temp_file_and_keeps_the_target() {
     let dir = TempDir::new("rename-fails");
     // A non-empty directory cannot be replaced by a file: the write succeeds, the rename fails.
-    let target = dir.join("taken.png");
+    let target = dir.path("taken.png");
     fs::create_dir(&target).expect("dir in the way");
     fs::write(target.join("keep"), b"keep").expect("content");
     assert_io_error(write_image(&target, 1, 1, &[g(0.5)], PngEncoding::Srgb), &target);
@@ -234,7 +204,7 @@ fn failed_rename_removes_the_temp_file_and_keeps_the_target() {
 #[test]
 fn concurrent_writers_never_collide_or_leave_temp_files() {
     let dir = TempDir::new("threads");
-    let path = dir.join("shared.bin");
+    let path = dir.path("shared.bin");
     let contents: Vec<Vec<u8>> = (0..8u8).map(|i| vec![i; 50_000 + usize::from(i)]).collect();
     std::thread::scope(|s| {
         for bytes in &contents {
@@ -285,9 +255,9 @@ fn linear_to_srgb8_matches_exact_formula() {
 fn check_output_path_accepts_writable_targets_and_leaves_nothing() {
     let dir = TempDir::new("check");
     for name in ["a.png", "b.EXR", "c.pfm"] {
-        check_output_path(&dir.join(name)).expect("writable path");
+        check_output_path(&dir.path(name)).expect("writable path");
     }
-    let existing = dir.join("existing.png");
+    let existing = dir.path("existing.png");
     fs::write(&existing, b"old").expect("existing file");
     check_output_path(&existing).expect("existing file may be overwritten");
     assert_eq!(fs::read(&existing).expect("untouched"), b"old");
@@ -299,7 +269,7 @@ fn check_output_path_accepts_writable_targets_and_leaves_nothing() {
 fn check_output_path_rejects_a_read_only_directory() {
     use std::os::unix::fs::PermissionsExt;
     let dir = TempDir::new("read-only");
-    let sub = dir.join("ro");
+    let sub = dir.path("ro");
     fs::create_dir(&sub).expect("subdir");
     fs::set_permissions(&sub, fs::Permissions::from_mode(0o555)).expect("chmod");
     // Root ignores directory permissions; then there is nothing to test.

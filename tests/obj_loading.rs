@@ -6,6 +6,8 @@ use flate2::write::GzEncoder;
 use glam::{Vec2, Vec3};
 use lumiere::scene::mesh::NO_INDEX;
 use lumiere::scene::obj::{ObjScene, load_obj, parse_obj, parse_obj_with_chunk_size};
+mod common;
+use common::TempDir;
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -44,29 +46,6 @@ fn assert_error(bytes: &[u8], line: usize, needle: &str) {
     let message = parse_error(bytes);
     assert!(message.starts_with(&format!("test.obj:{line}: ")), "wrong line in {message:?}, expected {line}");
     assert!(message.contains(needle), "{message:?} does not mention {needle:?}");
-}
-
-/// A fresh folder under the system temp dir, removed when dropped.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(test: &str) -> Self {
-        let path = std::env::temp_dir().join(format!("lumiere-obj-{}-{test}", std::process::id()));
-        std::fs::create_dir_all(&path).expect("create temp dir");
-        TempDir(path)
-    }
-
-    fn write(&self, name: &str, bytes: &[u8]) -> PathBuf {
-        let path = self.0.join(name);
-        std::fs::write(&path, bytes).expect("write temp file");
-        path
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
 }
 
 const SQUARE: &str = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n";

@@ -2,7 +2,6 @@
 //! stay finite on degenerate input.
 
 use std::fs;
-use std::path::PathBuf;
 use std::process::{Child, Command, Output, Stdio};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
@@ -14,25 +13,8 @@ use lumiere::scene::camera::Camera;
 use lumiere::scene::{Scene, builtin};
 use lumiere::world::World;
 
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(name: &str) -> TempDir {
-        let dir = std::env::temp_dir().join(format!("lumiere-progressive-{name}-{}", std::process::id()));
-        let _ = fs::remove_dir_all(&dir);
-        fs::create_dir_all(&dir).unwrap();
-        TempDir(dir)
-    }
-    fn path(&self, name: &str) -> String {
-        self.0.join(name).to_string_lossy().into_owned()
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = fs::remove_dir_all(&self.0);
-    }
-}
+mod common;
+use common::TempDir;
 
 fn lumiere(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_lumiere")).args(args).output().expect("the binary runs")
@@ -100,7 +82,7 @@ fn noise_target_stops_early_with_the_error_reached() {
 #[test]
 fn time_budget_stops_after_the_crossing_pass_and_says_why() {
     let dir = TempDir::new("time");
-    let out = dir.path("t.png");
+    let out = dir.arg("t.png");
     let start = Instant::now();
     let run = lumiere(&[
         "render",
@@ -129,8 +111,8 @@ fn time_budget_stops_after_the_crossing_pass_and_says_why() {
 fn interruption_writes_the_completed_samples_and_exits_3() {
     let dir = TempDir::new("interrupt");
     for name in ["INT", "TERM"] {
-        let out = dir.path(&format!("{name}.png"));
-        let stats = dir.path(&format!("{name}.json"));
+        let out = dir.arg(&format!("{name}.png"));
+        let stats = dir.arg(&format!("{name}.json"));
         let child = spawn(&[
             "render",
             "--mode",
@@ -165,15 +147,15 @@ fn killed_and_resumed_renders_give_identical_bytes() {
     let dir = TempDir::new("kill");
     // About 1.5 s of work, so that every kill point lands mid-render.
     let args = ["render", "--mode", "direct", "--samples", "8", "--spp", "96", "--size", "96x72", "--sampler", "sobol"];
-    let reference = dir.path("reference.pfm");
+    let reference = dir.arg("reference.pfm");
     let run = lumiere(&[&args[..], &["-o", &reference]].concat());
     assert!(run.status.success(), "{}", stderr(&run));
     let expected = fs::read(&reference).unwrap();
 
     let mut total_kills = 0;
     for (attempt, delay_ms) in [40u64, 150, 330, 520].into_iter().enumerate() {
-        let out = dir.path(&format!("resumed{attempt}.pfm"));
-        let checkpoint = dir.path(&format!("run{attempt}.ckpt"));
+        let out = dir.arg(&format!("resumed{attempt}.pfm"));
+        let checkpoint = dir.arg(&format!("run{attempt}.ckpt"));
         let mut kills = 0;
         loop {
             let mut command = vec!["--checkpoint", &checkpoint, "-o", &out];
@@ -203,8 +185,8 @@ fn killed_and_resumed_renders_give_identical_bytes() {
 #[test]
 fn resuming_with_other_inputs_or_a_broken_file_is_refused() {
     let dir = TempDir::new("refuse");
-    let checkpoint = dir.path("c.ckpt");
-    let out = dir.path("o.png");
+    let checkpoint = dir.arg("c.ckpt");
+    let out = dir.arg("o.png");
     let base = ["render", "--mode", "ao", "--samples", "4", "--spp", "2", "--size", "32x24"];
     let run = lumiere(&[&base[..], &["--checkpoint", &checkpoint, "-o", &out]].concat());
     assert!(run.status.success(), "{}", stderr(&run));
@@ -235,7 +217,7 @@ fn resuming_with_other_inputs_or_a_broken_file_is_refused() {
         ),
     ];
     for (args, expected) in cases {
-        let run = lumiere(&[args, &["--resume", &checkpoint, "-o", &dir.path("x.png")]].concat());
+        let run = lumiere(&[args, &["--resume", &checkpoint, "-o", &dir.arg("x.png")]].concat());
         assert_eq!(run.status.code(), Some(2), "{args:?}");
         assert!(stderr(&run).contains(expected), "{args:?}: {}", stderr(&run));
     }
@@ -271,13 +253,13 @@ fn degenerate_scenes_render_finite_images() {
         vn 0 0 0\n\
         usemtl white\nf 1//1 2//1 3//1 4//1\nf 11 12 13\n\
         usemtl light\nf 5 6 7\nf 8 9 10\n";
-    let scene = dir.path("d.obj");
+    let scene = dir.arg("d.obj");
     fs::write(&scene, obj).unwrap();
     let views: [&[&str]; 2] = [&["--eye", "0,3,4", "--target", "0,0,0"], &["--eye", "0,0.5,0", "--target", "0,0.5,-1"]];
     for mode in ["hits", "materials", "shadows", "direct", "ao"] {
         for view in views {
-            let out = dir.path("d.pfm");
-            let stats = dir.path("d.json");
+            let out = dir.arg("d.pfm");
+            let stats = dir.arg("d.json");
             let args = [
                 "render",
                 &scene,
