@@ -3,6 +3,7 @@
 use glam::Vec3;
 
 use crate::geometry::triangle::{triangle_area, triangle_normal};
+use crate::math::offset_ray_origin;
 use crate::scene::material::Material;
 use crate::scene::mesh::TriangleMesh;
 
@@ -12,6 +13,11 @@ use crate::scene::mesh::TriangleMesh;
 pub struct AreaLight {
     pub triangle: u32,
     pub vertices: [Vec3; 3],
+    /// The vertices moved a few ulps off the light's surface, to the emitting side (see
+    /// `offset_ray_origin`). Shadow rays end on this triangle: every point of it lies in front of the
+    /// light (a convex combination of points in front is in front), so a ray neither stops short of
+    /// the light nor reports the light itself as its occluder, with no per-ray offset.
+    pub shadow_targets: [Vec3; 3],
     pub normal: Vec3,
     pub area: f32,
     pub emission: Vec3,
@@ -20,6 +26,13 @@ pub struct AreaLight {
 impl AreaLight {
     pub fn centroid(&self) -> Vec3 {
         (self.vertices[0] + self.vertices[1] + self.vertices[2]) / 3.0
+    }
+
+    /// The point with barycentrics `b` on the shadow-target triangle (just in front of the light).
+    #[inline]
+    pub fn shadow_target(&self, b: Vec3) -> Vec3 {
+        let [p0, p1, p2] = self.shadow_targets;
+        b.x * p0 + b.y * p1 + b.z * p2
     }
 
     /// Radiant flux of a Lambertian emitter: `pi * L * A` per channel.
@@ -47,7 +60,8 @@ pub fn collect_lights(mesh: &TriangleMesh, materials: &[Material]) -> Vec<AreaLi
             let [p0, p1, p2] = vertices;
             let area = triangle_area(p0, p1, p2);
             let normal = triangle_normal(p0, p1, p2).try_normalize()?;
-            (area > 0.0).then_some(AreaLight { triangle: id as u32, vertices, normal, area, emission })
+            let shadow_targets = vertices.map(|v| offset_ray_origin(v, normal));
+            (area > 0.0).then_some(AreaLight { triangle: id as u32, vertices, shadow_targets, normal, area, emission })
         })
         .collect()
 }

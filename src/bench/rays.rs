@@ -36,7 +36,7 @@ pub struct RaySet {
 
 /// The benchmark's ray sets, in this order: primary (closest), shadow (occluded), diffuse
 /// (occluded), diffuse (closest). Shadow rays go to a uniform point of a light triangle chosen by
-/// index (ending just in front of it), or, in scenes without lights, to a point above the scene.
+/// index (ending just in front of it, as the renderer's do), or, in scenes without lights, to a point above the scene.
 pub fn make_ray_sets(world: &World, camera: &Camera, seed: u64) -> Vec<RaySet> {
     let sampler = Sampler::new(SamplerKind::Independent, seed);
     let (width, height) = (camera.width, camera.height);
@@ -60,11 +60,8 @@ pub fn make_ray_sets(world: &World, camera: &Camera, seed: u64) -> Vec<RaySet> {
             } else {
                 let light = &lights[(sampler.get_1d(pixel, 0, 0) * lights.len() as f32) as usize % lights.len()];
                 let b = sample_uniform_triangle(sampler.get_2d(pixel, 0, 1));
-                let [p0, p1, p2] = light.vertices;
-                let y = b.x * p0 + b.y * p1 + b.z * p2;
-                // As the renderer does: end a few ulps in front of the light, on the origin's side.
-                let towards_origin = if light.normal.dot(origin - y) >= 0.0 { light.normal } else { -light.normal };
-                offset_ray_origin(y, towards_origin)
+                // As the renderer does: end on the light's shadow-target triangle, just in front of it.
+                light.shadow_target(b)
             };
             let shadow = Ray::segment(origin, target);
             let local = sample_cosine_hemisphere(sampler.get_2d(pixel, 0, 2));

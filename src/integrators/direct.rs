@@ -44,8 +44,9 @@ impl Direct {
     }
 }
 
-/// The unoccluded contribution of the light point `y` to `surface`, divided by the area pdf, and
-/// the shadow segment that decides its visibility; `None` when a cosine is not positive.
+/// The unoccluded contribution of the light point `y` (sampled on the light's shadow-target
+/// triangle, a few ulps in front of it) to `surface`, divided by the area pdf, and the shadow
+/// segment that decides its visibility; `None` when a cosine is not positive.
 ///
 /// `cos(theta) cos(theta_s) / d^2` is evaluated as `(n . v)(-n_s . v) / (v . v)^2` with the
 /// unnormalised `v = y - p`: no square root and one division per sample.
@@ -58,8 +59,7 @@ fn light_sample(surface: &SurfacePoint, origin: Vec3, light: &AreaLight, y: Vec3
         return None;
     }
     let d2 = v.length_squared();
-    let target = offset_ray_origin(y, light.normal);
-    Some((light.emission * (cos_surface * cos_light / (d2 * d2)), Ray::segment(origin, target)))
+    Some((light.emission * (cos_surface * cos_light / (d2 * d2)), Ray::segment(origin, y)))
 }
 
 /// False when no point of the light can contribute: the light lies wholly below the surface's
@@ -72,9 +72,7 @@ fn faces_each_other(surface: &SurfacePoint, light: &AreaLight) -> bool {
 
 #[inline(always)]
 fn point_on(light: &AreaLight, u: glam::Vec2) -> Vec3 {
-    let b = sample_uniform_triangle(u);
-    let [p0, p1, p2] = light.vertices;
-    b.x * p0 + b.y * p1 + b.z * p2
+    light.shadow_target(sample_uniform_triangle(u))
 }
 
 impl Integrator for Direct {
@@ -98,7 +96,7 @@ impl Integrator for Direct {
                     if !faces_each_other(&surface, light) {
                         continue;
                     }
-                    let Some(shaft) = Region::shaft(origin, light.vertices) else { continue };
+                    let Some(shaft) = Region::shaft(origin, light.shadow_targets) else { continue };
                     batch.prepare(&world.bvh, origin, &shaft);
                     let dimension = dims::LIGHT_POINT + index as u32;
                     let mut light_sum = Vec3::ZERO;

@@ -31,9 +31,8 @@ impl Integrator for Shadows {
             if cos_surface <= 0.0 || cos_light <= 0.0 || surface.ng.dot(wi) <= 0.0 {
                 continue;
             }
-            // The segment ends just in front of the light, so it neither stops short of the light nor
-            // reports the light itself as the occluder.
-            let target = offset_ray_origin(centroid, light.normal);
+            // The segment ends on the light's shadow-target triangle, just in front of the light.
+            let target = light.shadow_target(Vec3::splat(1.0 / 3.0));
             ctx.rays += 1;
             if world.occluded(&Ray::segment(origin, target)) {
                 continue;
