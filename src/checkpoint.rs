@@ -81,13 +81,14 @@ impl Checkpoint {
         let (width, height, samples) = (reader.u32(), reader.u32(), reader.u32());
         let (seed, rays, discarded) = (reader.u64(), reader.u64(), reader.u64());
         let elapsed = reader.f64();
-        let pixels = width as u64 * height as u64;
-        if width == 0 || height == 0 || reader.bytes.len() as u64 != pixels * 32 {
+        // In u128: width * height * 32 overflows u64 for the largest u32 sizes.
+        let pixels = width as u128 * height as u128;
+        if width == 0 || height == 0 || reader.bytes.len() as u128 != pixels * 32 {
             return Err(bad("its size does not match its pixel data"));
         }
-        if !(elapsed.is_finite() && elapsed >= 0.0) {
+        let Ok(elapsed) = Duration::try_from_secs_f64(elapsed) else {
             return Err(bad("invalid elapsed time"));
-        }
+        };
         let mut film = Film::new(width, height)?;
         for (sum, sq) in film.sum.iter_mut().zip(film.sum_sq.iter_mut()) {
             *sum = [reader.f64(), reader.f64(), reader.f64()];
@@ -95,7 +96,7 @@ impl Checkpoint {
         }
         film.samples = samples;
         film.discarded = discarded;
-        let stats = RenderStats { rays, elapsed: Duration::from_secs_f64(elapsed) };
+        let stats = RenderStats { rays, elapsed };
         Ok(Checkpoint { scene_fingerprint, options_fingerprint, seed, film, stats })
     }
 }

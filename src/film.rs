@@ -94,9 +94,10 @@ impl Film {
 
 /// Refuses sizes whose buffers cannot fit, naming the memory they need.
 fn check_memory(width: u32, height: u32) -> Result<()> {
-    let needed = width as u64 * height as u64 * BYTES_PER_PIXEL;
+    // In u128: width * height * bytes overflows u64 for the largest u32 sizes.
+    let needed = width as u128 * height as u128 * BYTES_PER_PIXEL as u128;
     let available = available_memory().unwrap_or(64 << 30);
-    if needed > available {
+    if needed > available as u128 {
         return Err(Error::invalid(format!(
             "image size {width}x{height} needs {:.1} GiB of memory to render; {:.1} GiB is available",
             needed as f64 / (1u64 << 30) as f64,
@@ -106,10 +107,20 @@ fn check_memory(width: u32, height: u32) -> Result<()> {
     Ok(())
 }
 
-/// `MemAvailable` from /proc/meminfo, where there is one.
-fn available_memory() -> Option<u64> {
-    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib * 1024)
+/// Memory this process can still get: `MemAvailable` from /proc/meminfo, capped by the
+/// address-space limit (`ulimit -v`) from /proc/self/limits; `None` where neither is known.
+pub(crate) fn available_memory() -> Option<u64> {
+    let meminfo = std::fs::read_to_string("/proc/meminfo").ok().and_then(|info| {
+        let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
+        Some(line.split_whitespace().nth(1)?.parse::<u64>().ok()? * 1024)
+    });
+    let address_space = std::fs::read_to_string("/proc/self/limits").ok().and_then(|limits| {
+        let line = limits.lines().find(|l| l.starts_with("Max address space"))?;
+        // "Max address space  <soft> <hard> bytes"; "unlimited" does not parse and gives None.
+        line.split_whitespace().nth(3)?.parse::<u64>().ok()
+    });
+    match (meminfo, address_space) {
+        (Some(a), Some(b)) => Some(a.min(b)),
+        (a, b) => a.or(b),
+    }
 }

@@ -6,16 +6,20 @@
 //! ids in range, finite numbers) while an error must be one line naming the file and a real line.
 //! The CLI's value parsers (`--size`, `--eye`, ...) are fuzzed through the binary, a few cases.
 //!
-//! Case counts are fixed and the seed is proptest's default (deterministic per run unless
-//! `PROPTEST_RNG_SEED` is set); raise `PROPTEST_CASES` to search longer, e.g.
-//! `PROPTEST_CASES=20000 cargo test --release --test fuzz_parsers`. See docs/FUZZING.md.
+//! Case counts are fixed (about 3 s in all with `--release`); the seed is random per run, so each
+//! CI run searches new inputs, and a failure prints the minimal input. Reproduce a run with
+//! `PROPTEST_RNG_SEED=<n>`, search longer with `FUZZ_CASES_SCALE=<k>` (k times the cases), e.g.
+//! `FUZZ_CASES_SCALE=50 cargo test --release --test fuzz_parsers`. See docs/FUZZING.md.
 
 #[path = "../fuzz/src/harness.rs"]
 mod harness;
 #[path = "../fuzz/src/process.rs"]
 mod process;
 
-use harness::{guarded, mtl_target, obj_chunks_target, obj_target, orbiter_target, scene_target};
+use harness::{
+    checkpoint_target, guarded, mtl_target, obj_chunks_target, obj_target, orbiter_target, raw_checkpoint,
+    scene_target, with_checksum,
+};
 use process::{Limits, TempDir, check_exit, run};
 use proptest::prelude::*;
 use proptest::sample::Index;
@@ -260,9 +264,12 @@ fn token_soup() -> impl Strategy<Value = Vec<u8>> {
     prop::collection::vec(line, 0..40).prop_map(|lines| lines.join(&b'\n'))
 }
 
+/// `cases` cases, times `FUZZ_CASES_SCALE` when set (to search longer than CI does). The seed is
+/// random per run (proptest's default) unless `PROPTEST_RNG_SEED` is set.
 fn config(cases: u32) -> ProptestConfig {
+    let scale = std::env::var("FUZZ_CASES_SCALE").ok().and_then(|s| s.parse::<u32>().ok()).unwrap_or(1).max(1);
     // No regression files: they would land in tests/; failing inputs belong in tests/corpus/.
-    ProptestConfig { cases, failure_persistence: None, ..ProptestConfig::default() }
+    ProptestConfig { cases: cases.saturating_mul(scale), failure_persistence: None, ..ProptestConfig::default() }
 }
 
 /// `guarded` as a proptest assertion.
@@ -280,7 +287,7 @@ fn with_mtl(obj: &[u8], mtl: &[u8]) -> Vec<u8> {
 }
 
 proptest! {
-    #![proptest_config(config(2000))]
+    #![proptest_config(config(5000))]
 
     #[test]
     fn obj_random_bytes(data in prop::collection::vec(any::<u8>(), 0..1024)) {
@@ -299,7 +306,7 @@ proptest! {
 }
 
 proptest! {
-    #![proptest_config(config(1500))]
+    #![proptest_config(config(4000))]
 
     #[test]
     fn obj_token_soup(obj in token_soup(), chunk in any::<u8>()) {
@@ -334,13 +341,43 @@ proptest! {
 }
 
 proptest! {
-    #![proptest_config(config(150))]
+    #![proptest_config(config(400))]
 
     /// Whatever parses must also build a BVH and render in every mode (8x6, 1 sample).
     #[test]
     fn scene_mutated_shipped_scenes(scene in 0..OBJS.len(), mutations in prop::collection::vec(mutation(), 1..6)) {
         let obj = mutate(OBJS[scene], &mutations, &[CORNELL_OBJ, MCGUIRE_OBJ]);
         check!(scene_target, with_mtl(&obj, MTLS[scene]));
+    }
+}
+
+/// A valid checkpoint to mutate: `width` x `height` pixels of data, checksum included.
+fn valid_checkpoint(width: u32, height: u32) -> Vec<u8> {
+    raw_checkpoint(width, height, 4, 1.5, (width * height) as usize)
+}
+
+proptest! {
+    #![proptest_config(config(4000))]
+
+    #[test]
+    fn checkpoint_random_bytes(data in prop::collection::vec(any::<u8>(), 0..256)) {
+        check!(checkpoint_target, data);
+    }
+
+    /// Mutations of valid checkpoints, with the checksum recomputed afterwards (flag 1) so that
+    /// the header and size checks behind it are exercised, or left stale (flag 0).
+    #[test]
+    fn checkpoint_mutated_valid_files(
+        width in 1u32..4,
+        height in 1u32..4,
+        mutations in prop::collection::vec(mutation(), 1..6),
+        fix_checksum in any::<bool>(),
+    ) {
+        let valid = valid_checkpoint(width, height);
+        let body = mutate(&valid[..valid.len() - 8], &mutations, &[&valid]);
+        let bytes = if fix_checksum { with_checksum(&body) } else { [&body[..], &valid[valid.len() - 8..]].concat() };
+        // Flag 0: decode these exact bytes.
+        check!(checkpoint_target, [&[0u8][..], &bytes].concat());
     }
 }
 
@@ -456,7 +493,7 @@ fn render_arguments() -> impl Strategy<Value = Vec<String>> {
 }
 
 proptest! {
-    #![proptest_config(config(40))]
+    #![proptest_config(config(60))]
 
     /// `render --mode hits` with hostile option values: exit 0, or 2 with a clap usage error or
     /// one `lumiere: error:` line; never a panic, a signal or a hang.

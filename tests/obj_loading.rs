@@ -399,3 +399,10 @@ fn bunny_1m_loads_fast() {
     assert_eq!(scene.mesh.positions.len(), 557_164);
     assert!(scene.mesh.normal_indices.is_empty() && scene.mesh.texcoord_indices.is_empty());
 }
+
+#[test]
+fn a_utf8_byte_order_mark_is_skipped() {
+    let no_mtl = |_: &str| Err(io::Error::new(io::ErrorKind::NotFound, "none"));
+    let scene = parse_obj(b"\xEF\xBB\xBFv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", Path::new("bom.obj"), &no_mtl).unwrap();
+    assert_eq!((scene.mesh.positions.len(), scene.mesh.triangle_count()), (3, 1));
+}

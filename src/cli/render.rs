@@ -212,13 +212,18 @@ fn make_camera(args: &RenderArgs, scene: &Scene) -> Result<Camera> {
         return Ok(Camera::from_orbiter(&builtin::cornell_orbiter()?, width, height));
     }
     let bounds = scene.bounds();
+    let cannot_frame = |why: &str| Error::invalid(format!("{}: {why}; give --eye and --target", scene.name));
     if bounds.is_empty() {
-        return Err(Error::invalid(format!("{}: no vertices to frame; give --eye and --target", scene.name)));
+        return Err(cannot_frame("no vertices to frame"));
     }
     let radius = 0.5 * bounds.extent().length();
     let distance = radius / (0.5 * args.fov.to_radians()).sin();
     let target = bounds.center();
-    Camera::look_at(target + glam::Vec3::Z * distance.max(1e-6), target, args.up, args.fov, width, height)
+    let eye = target + glam::Vec3::Z * distance.max(1e-6);
+    if !(eye.is_finite() && target.is_finite()) || eye == target {
+        return Err(cannot_frame("its bounds are too large (or too far from the origin) to frame automatically"));
+    }
+    Camera::look_at(eye, target, args.up, args.fov, width, height)
 }
 
 fn progress_bar(total: u64, done: u64) -> ProgressBar {

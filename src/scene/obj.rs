@@ -65,6 +65,8 @@ pub fn parse_obj(
 /// inputs and compare with a single chunk (`usize::MAX`).
 #[doc(hidden)]
 pub fn parse_obj_with_chunk_size(bytes: &[u8], name: &Path, read_mtl: ReadMtl, chunk_bytes: usize) -> Result<ObjScene> {
+    // Editors on Windows may start the file with a UTF-8 byte-order mark.
+    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
     let chunks = split_lines(bytes, chunk_bytes.max(1));
     let counts: Vec<ChunkCounts> = chunks.par_iter().map(|chunk| ChunkCounts::of(chunk)).collect();
     let (starts, totals) = chunk_starts(&counts);
@@ -85,8 +87,17 @@ fn read_file(path: &Path) -> io::Result<Vec<u8>> {
     if !path.extension().is_some_and(|extension| extension.eq_ignore_ascii_case("gz")) {
         return Ok(raw);
     }
+    // A few kilobytes of gzip can expand to gigabytes: stop at a quarter of the free memory, which
+    // leaves room for the mesh parsed from the text.
+    let limit = crate::film::available_memory().unwrap_or(16 << 30) / 4;
     let mut bytes = Vec::new();
-    flate2::read::MultiGzDecoder::new(&raw[..]).read_to_end(&mut bytes)?;
+    flate2::read::MultiGzDecoder::new(&raw[..]).take(limit + 1).read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > limit {
+        return Err(io::Error::other(format!(
+            "decompresses to more than {:.1} GiB, over a quarter of the free memory; refusing it",
+            limit as f64 / (1u64 << 30) as f64
+        )));
+    }
     Ok(bytes)
 }
 

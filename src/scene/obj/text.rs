@@ -53,8 +53,14 @@ impl<'a> Iterator for Tokens<'a> {
 }
 
 /// A token quoted for an error message, readable even when it is not UTF-8.
+/// The token as it should appear in an error message: quoted, and cut to its first 40 bytes so
+/// that a hostile 10 MB token does not make a 10 MB message.
 pub(super) fn quoted(token: &[u8]) -> String {
-    format!("{:?}", String::from_utf8_lossy(token))
+    const SHOWN: usize = 40;
+    if token.len() <= SHOWN {
+        return format!("{:?}", String::from_utf8_lossy(token));
+    }
+    format!("{:?}... ({} bytes)", String::from_utf8_lossy(&token[..SHOWN]), token.len())
 }
 
 /// Parses a finite `f32`. NaN and infinities are refused: they would poison the BVH bounds.
