@@ -128,12 +128,16 @@ fn intersect_block(ray: &TriangleRay4, block: &TriangleBlock, tmax: f32) -> Bloc
     let negative = u.lt(zero) | v.lt(zero) | w.lt(zero);
     let positive = u.gt(zero) | v.gt(zero) | w.gt(zero);
     let inside = !(negative.bits() & positive.bits()) & 0xF;
+    let zero_edge = (u.eq(zero) | v.eq(zero) | w.eq(zero)).bits();
+    // Most blocks a ray reaches have no lane inside all three edges: skip the distance entirely.
+    if inside | zero_edge == 0 {
+        return BlockHits { mask: 0, t: [0.0; 4], u: [0.0; 4], v: [0.0; 4] };
+    }
     let det = u + v + w;
     let (az, bz, cz) = (sz * a_kz, sz * b_kz, sz * c_kz);
     let t_scaled = u * az + v * bz + w * cz;
     // Lanes the scalar test redoes in f64: an edge function exactly 0, overflow, or cancellation
     // (the same `cancels` condition, evaluated with the same operations).
-    let zero_edge = (u.eq(zero) | v.eq(zero) | w.eq(zero)).bits();
     let overflow = !(det.is_finite() & t_scaled.is_finite()).bits() & 0xF;
     let error = (u1.abs() + u2.abs()) * az.abs() + (v1.abs() + v2.abs()) * bz.abs() + (w1.abs() + w2.abs()) * cz.abs();
     let cancel = (error * F32x4::splat(CANCELLATION_ERROR)).gt(t_scaled.abs()).bits();
