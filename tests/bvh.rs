@@ -156,7 +156,7 @@ fn origin_batches_agree_with_traversal() {
             let normal = rng.direction();
             let (region, shaft) = match Region::shaft(origin, corners) {
                 Some(r) if rng.f32() < 0.5 => (r, true),
-                _ => (Region::hemisphere(origin, normal, f32::INFINITY), false),
+                _ => (Region::hemisphere(origin, normal), false),
             };
             batch.prepare(&wide, origin, &region);
             batched += usize::from(batch.candidate_blocks().is_some());
@@ -188,7 +188,7 @@ fn origin_batches_never_leak_through_a_closed_mesh() {
     let origin = Vec3::new(0.1, -0.2, 0.05);
     let mut batch = OriginBatch::default();
     for normal in [Vec3::X, Vec3::NEG_Y, Vec3::new(0.3, 0.4, -0.5).normalize()] {
-        batch.prepare(&wide, origin, &Region::hemisphere(origin, normal, f32::INFINITY));
+        batch.prepare(&wide, origin, &Region::hemisphere(origin, normal));
         assert!(batch.candidate_blocks().is_some());
         for &p in &positions {
             let dir = p - origin;

@@ -37,10 +37,13 @@ struct PluckerBlock {
 #[derive(Clone, Copy, Debug)]
 pub struct Region {
     planes: [Vec4; 4],
+    /// A box or triangle is kept only if it reaches above `keep_above[i]` on plane `i`. Planes
+    /// through the origin of the rays get a small negative margin (the few-ulp offsets of ray ends
+    /// and the rounding of the plane equations); planes the rays cannot reach (the light's, which
+    /// the segments end in front of; the surface's, which the rays leave) get 0, so that what lies
+    /// on them (the light itself, a coplanar ceiling, the floor under a point) is left out.
+    keep_above: [f32; 4],
     count: usize,
-    /// Boxes are kept unless outside a plane by more than this (absorbs the few-ulp offsets of ray
-    /// ends and the rounding of the plane equations).
-    tolerance: f32,
 }
 
 impl Region {
@@ -61,28 +64,38 @@ impl Region {
             let n = if n.dot(centroid - a) < 0.0 { -n } else { n };
             *plane = n.extend(-n.dot(a));
         }
-        Some(Region { planes, count: 4, tolerance: tolerance(origin, size) })
+        let margin = -tolerance(origin, size);
+        // The segments end on the triangle `corners` (the light's shadow targets): nothing on or
+        // beyond its plane can block them.
+        Some(Region { planes, keep_above: [margin, margin, margin, 0.0], count: 4 })
     }
 
-    /// The half-space on the side `normal` points to, cut to a cube of half-size `distance`
-    /// around `origin` when the distance is finite.
-    pub fn hemisphere(origin: Vec3, normal: Vec3, distance: f32) -> Region {
+    /// The half-space above the plane through `origin` with normal `normal`: rays leaving `origin`
+    /// on that side never reach anything on or below the plane.
+    pub fn hemisphere(origin: Vec3, normal: Vec3) -> Region {
         let n = normal.normalize();
         let mut planes = [Vec4::ZERO; 4];
         planes[0] = n.extend(-n.dot(origin));
-        Region { planes, count: 1, tolerance: tolerance(origin, if distance.is_finite() { distance } else { 0.0 }) }
+        Region { planes, keep_above: [0.0; 4], count: 1 }
+    }
+
+    /// True unless the triangle lies wholly at or below `keep_above` of one of the planes.
+    fn keeps_triangle(&self, corners: &[Vec3; 3]) -> bool {
+        self.planes[..self.count].iter().zip(&self.keep_above).all(|(plane, &keep_above)| {
+            corners.iter().map(|c| plane.truncate().dot(*c) + plane.w).fold(f32::NEG_INFINITY, f32::max) > keep_above
+        })
     }
 
     fn contains_box(&self, node_bounds: &[[f32; 4]; 6]) -> u32 {
         let mut inside = 0xF;
-        for plane in &self.planes[..self.count] {
+        for (plane, &keep_above) in self.planes[..self.count].iter().zip(&self.keep_above) {
             // The corner of each box farthest along the plane normal.
             let far = |axis: usize| {
                 let row = if plane[axis] >= 0.0 { axis + 3 } else { axis };
                 F32x4::load(&node_bounds[row]) * F32x4::splat(plane[axis])
             };
             let distance = far(0) + far(1) + far(2) + F32x4::splat(plane.w);
-            inside &= distance.gt(F32x4::splat(-self.tolerance)).bits();
+            inside &= distance.gt(F32x4::splat(keep_above)).bits();
         }
         inside
     }
@@ -111,6 +124,8 @@ impl OriginBatch {
         if bvh.triangle_count() == 0 {
             return;
         }
+        // Triangles kept but not yet packed into a block of four.
+        let mut pending = arrayvec_like::Pending::default();
         // Depth-first walk of the region; a wide level pushes at most four children.
         let mut stack = [0u32; 4 * super::build::MAX_DEPTH + 1];
         let mut len = 1;
@@ -119,12 +134,27 @@ impl OriginBatch {
             let reference = stack[len];
             if reference & LEAF_BIT != 0 {
                 for block in &bvh.blocks[leaf_blocks(reference)] {
-                    if self.blocks.len() == MAX_CANDIDATE_BLOCKS {
-                        self.traverse = true;
-                        self.blocks.clear();
-                        return;
+                    for lane in 0..4 {
+                        // Padding lanes repeat the block's last triangle: skip the repeats.
+                        if lane > 0 && block.ids[lane] == block.ids[lane - 1] {
+                            continue;
+                        }
+                        let corner = |c: usize| Vec3::from_array([0, 1, 2].map(|a| block.vertices[c][a][lane]));
+                        let triangle = [corner(0), corner(1), corner(2)];
+                        if !region.keeps_triangle(&triangle) {
+                            continue;
+                        }
+                        if pending.len() == 4 {
+                            self.blocks.push(plucker_block(origin, &pending));
+                            pending.clear();
+                        }
+                        if self.blocks.len() == MAX_CANDIDATE_BLOCKS {
+                            self.traverse = true;
+                            self.blocks.clear();
+                            return;
+                        }
+                        pending.push(triangle);
                     }
-                    self.blocks.push(plucker_block(origin, &block.vertices));
                 }
                 continue;
             }
@@ -136,6 +166,9 @@ impl OriginBatch {
                 stack[len] = node.children[slot];
                 len += 1;
             }
+        }
+        if !pending.is_empty() {
+            self.blocks.push(plucker_block(origin, &pending));
         }
         self.order_by_solid_angle();
     }
@@ -183,14 +216,13 @@ impl OriginBatch {
     }
 }
 
-/// Edge vectors and plane of four triangles relative to `origin`.
-#[expect(clippy::needless_range_loop, reason = "one SoA lane index addresses several arrays")]
-fn plucker_block(origin: Vec3, vertices: &[[[f32; 4]; 3]; 3]) -> PluckerBlock {
+/// Edge vectors and planes of up to four triangles relative to `origin`; missing lanes repeat the
+/// last triangle (a duplicate never changes an any-hit answer).
+fn plucker_block(origin: Vec3, triangles: &[[Vec3; 3]]) -> PluckerBlock {
     let mut block =
         PluckerBlock { edges: [[[0.0; 4]; 3]; 3], normal: [[0.0; 4]; 3], plane_offset: [0.0; 4], solid_angle: 0.0 };
     for lane in 0..4 {
-        let corner = |c: usize| Vec3::new(vertices[c][0][lane], vertices[c][1][lane], vertices[c][2][lane]);
-        let (p0, p1, p2) = (corner(0), corner(1), corner(2));
+        let [p0, p1, p2] = triangles[lane.min(triangles.len() - 1)];
         let (a, b, c) = (p0 - origin, p1 - origin, p2 - origin);
         let edges = [b.cross(c), c.cross(a), a.cross(b)];
         let normal = (p1 - p0).cross(p2 - p0);
@@ -201,12 +233,47 @@ fn plucker_block(origin: Vec3, vertices: &[[[f32; 4]; 3]; 3]) -> PluckerBlock {
             block.normal[axis][lane] = normal[axis];
         }
         block.plane_offset[lane] = a.dot(normal);
-        // Projected area over squared distance: |n . (c - o)| / |c - o|^3 with |n| = twice the area.
-        let to_centroid = (a + b + c) / 3.0;
-        let distance = to_centroid.length().max(f32::MIN_POSITIVE);
-        let projected = normal.dot(to_centroid).abs() / (distance * distance * distance);
-        // Duplicated padding lanes repeat the last triangle; counting them twice only affects order.
-        block.solid_angle += if projected.is_finite() { projected } else { f32::MAX };
+        if lane < triangles.len() {
+            // Projected area over squared distance: |n . (c - o)| / |c - o|^3 with |n| = twice the area.
+            let to_centroid = (a + b + c) / 3.0;
+            let distance = to_centroid.length().max(f32::MIN_POSITIVE);
+            let projected = normal.dot(to_centroid).abs() / (distance * distance * distance);
+            block.solid_angle += if projected.is_finite() { projected } else { f32::MAX };
+        }
     }
     block
+}
+
+/// A fixed-capacity list of up to four triangles, so that gathering candidates allocates nothing.
+mod arrayvec_like {
+    use glam::Vec3;
+
+    #[derive(Default)]
+    pub struct Pending {
+        triangles: [[Vec3; 3]; 4],
+        len: usize,
+    }
+
+    impl Pending {
+        pub fn push(&mut self, triangle: [Vec3; 3]) {
+            self.triangles[self.len] = triangle;
+            self.len += 1;
+        }
+        pub fn len(&self) -> usize {
+            self.len
+        }
+        pub fn is_empty(&self) -> bool {
+            self.len == 0
+        }
+        pub fn clear(&mut self) {
+            self.len = 0;
+        }
+    }
+
+    impl std::ops::Deref for Pending {
+        type Target = [[Vec3; 3]];
+        fn deref(&self) -> &Self::Target {
+            &self.triangles[..self.len]
+        }
+    }
 }

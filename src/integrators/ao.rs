@@ -26,7 +26,7 @@ impl Integrator for AmbientOcclusion {
         let origin = offset_ray_origin(surface.p, surface.ng);
         // All probes leave from `origin` into the half-space above the surface: trace them as a batch.
         let mut batch = std::mem::take(&mut ctx.batch);
-        batch.prepare(&world.bvh, origin, &Region::hemisphere(origin, surface.ng, self.distance));
+        batch.prepare(&world.bvh, origin, &Region::hemisphere(origin, surface.ng));
         let mut visible = 0u32;
         for k in 0..self.samples {
             let local = sample_cosine_hemisphere(ctx.point_2d(dims::HEMISPHERE, k, self.samples));
