@@ -79,11 +79,20 @@ impl Region {
         Region { planes, keep_above: [0.0; 4], count: 1 }
     }
 
-    /// True unless the triangle lies wholly at or below `keep_above` of one of the planes.
-    fn keeps_triangle(&self, corners: &[Vec3; 3]) -> bool {
-        self.planes[..self.count].iter().zip(&self.keep_above).all(|(plane, &keep_above)| {
-            corners.iter().map(|c| plane.truncate().dot(*c) + plane.w).fold(f32::NEG_INFINITY, f32::max) > keep_above
-        })
+    /// Mask of the block's four triangles that do not lie wholly at or below `keep_above` of a plane.
+    fn keeps_triangles(&self, vertices: &[[[f32; 4]; 3]; 3]) -> u32 {
+        let mut kept = 0xF;
+        for (plane, &keep_above) in self.planes[..self.count].iter().zip(&self.keep_above) {
+            let distance = |corner: &[[f32; 4]; 3]| {
+                F32x4::load(&corner[0]) * F32x4::splat(plane.x)
+                    + F32x4::load(&corner[1]) * F32x4::splat(plane.y)
+                    + F32x4::load(&corner[2]) * F32x4::splat(plane.z)
+                    + F32x4::splat(plane.w)
+            };
+            let highest = distance(&vertices[0]).max(distance(&vertices[1])).max(distance(&vertices[2]));
+            kept &= highest.gt(F32x4::splat(keep_above)).bits();
+        }
+        kept
     }
 
     fn contains_box(&self, node_bounds: &[[f32; 4]; 6]) -> u32 {
@@ -134,14 +143,12 @@ impl OriginBatch {
             let reference = stack[len];
             if reference & LEAF_BIT != 0 {
                 for block in &bvh.blocks[leaf_blocks(reference)] {
-                    for lane in 0..4 {
+                    let mut kept = region.keeps_triangles(&block.vertices);
+                    while kept != 0 {
+                        let lane = kept.trailing_zeros() as usize;
+                        kept &= kept - 1;
                         // Padding lanes repeat the block's last triangle: skip the repeats.
                         if lane > 0 && block.ids[lane] == block.ids[lane - 1] {
-                            continue;
-                        }
-                        let corner = |c: usize| Vec3::from_array([0, 1, 2].map(|a| block.vertices[c][a][lane]));
-                        let triangle = [corner(0), corner(1), corner(2)];
-                        if !region.keeps_triangle(&triangle) {
                             continue;
                         }
                         if pending.len() == 4 {
@@ -153,7 +160,7 @@ impl OriginBatch {
                             self.blocks.clear();
                             return;
                         }
-                        pending.push(triangle);
+                        pending.push(block, lane);
                     }
                 }
                 continue;
@@ -216,47 +223,60 @@ impl OriginBatch {
     }
 }
 
-/// Edge vectors and planes of up to four triangles relative to `origin`; missing lanes repeat the
-/// last triangle (a duplicate never changes an any-hit answer).
-fn plucker_block(origin: Vec3, triangles: &[[Vec3; 3]]) -> PluckerBlock {
-    let mut block =
-        PluckerBlock { edges: [[[0.0; 4]; 3]; 3], normal: [[0.0; 4]; 3], plane_offset: [0.0; 4], solid_angle: 0.0 };
-    for lane in 0..4 {
-        let [p0, p1, p2] = triangles[lane.min(triangles.len() - 1)];
-        let (a, b, c) = (p0 - origin, p1 - origin, p2 - origin);
-        let edges = [b.cross(c), c.cross(a), a.cross(b)];
-        let normal = (p1 - p0).cross(p2 - p0);
-        for axis in 0..3 {
-            for (e, edge) in edges.iter().enumerate() {
-                block.edges[e][axis][lane] = edge[axis];
-            }
-            block.normal[axis][lane] = normal[axis];
-        }
-        block.plane_offset[lane] = a.dot(normal);
-        if lane < triangles.len() {
-            // Projected area over squared distance: |n . (c - o)| / |c - o|^3 with |n| = twice the area.
-            let to_centroid = (a + b + c) / 3.0;
-            let distance = to_centroid.length().max(f32::MIN_POSITIVE);
-            let projected = normal.dot(to_centroid).abs() / (distance * distance * distance);
-            block.solid_angle += if projected.is_finite() { projected } else { f32::MAX };
-        }
+/// Edge vectors and planes of up to four triangles (SoA, `vertices[corner][axis][lane]`) relative
+/// to `origin`, computed four lanes at a time; unused lanes repeat the last triangle (a duplicate
+/// never changes an any-hit answer).
+fn plucker_block(origin: Vec3, pending: &arrayvec_like::Pending) -> PluckerBlock {
+    let vertices = pending.soa();
+    let o = origin.to_array();
+    let rel = |c: usize| -> [F32x4; 3] { [0, 1, 2].map(|a| F32x4::load(&vertices[c][a]) - F32x4::splat(o[a])) };
+    let (a, b, c) = (rel(0), rel(1), rel(2));
+    let cross = |u: &[F32x4; 3], v: &[F32x4; 3]| {
+        [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
+    };
+    let sub = |u: &[F32x4; 3], v: &[F32x4; 3]| [u[0] - v[0], u[1] - v[1], u[2] - v[2]];
+    let dot = |u: &[F32x4; 3], v: &[F32x4; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+    let edges = [cross(&b, &c), cross(&c, &a), cross(&a, &b)];
+    let normal = cross(&sub(&b, &a), &sub(&c, &a));
+    let to_array = |v: [F32x4; 3]| v.map(F32x4::to_array);
+    let mut block = PluckerBlock {
+        edges: edges.map(to_array),
+        normal: to_array(normal),
+        plane_offset: dot(&a, &normal).to_array(),
+        solid_angle: 0.0,
+    };
+    // Projected area over squared distance, |n . (c - o)| / |c - o|^3 with |n| twice the area, of
+    // the real lanes: for ordering only.
+    let centroid = [0, 1, 2].map(|k| ((a[k] + b[k] + c[k]) * F32x4::splat(1.0 / 3.0)).to_array());
+    for lane in 0..pending.len() {
+        let [cx, cy, cz] = centroid.map(|axis| axis[lane]);
+        let to_centroid = Vec3::new(cx, cy, cz);
+        let n = Vec3::new(block.normal[0][lane], block.normal[1][lane], block.normal[2][lane]);
+        let distance = to_centroid.length().max(f32::MIN_POSITIVE);
+        let projected = n.dot(to_centroid).abs() / (distance * distance * distance);
+        block.solid_angle += if projected.is_finite() { projected } else { f32::MAX };
     }
     block
 }
 
-/// A fixed-capacity list of up to four triangles, so that gathering candidates allocates nothing.
+/// Up to four gathered triangles in SoA layout, so that packing them allocates nothing.
 mod arrayvec_like {
-    use glam::Vec3;
+    use crate::accel::wide::TriangleBlock;
 
     #[derive(Default)]
     pub struct Pending {
-        triangles: [[Vec3; 3]; 4],
+        vertices: [[[f32; 4]; 3]; 3],
         len: usize,
     }
 
     impl Pending {
-        pub fn push(&mut self, triangle: [Vec3; 3]) {
-            self.triangles[self.len] = triangle;
+        /// Appends triangle `lane` of `block`.
+        pub fn push(&mut self, block: &TriangleBlock, lane: usize) {
+            for corner in 0..3 {
+                for axis in 0..3 {
+                    self.vertices[corner][axis][self.len] = block.vertices[corner][axis][lane];
+                }
+            }
             self.len += 1;
         }
         pub fn len(&self) -> usize {
@@ -268,12 +288,17 @@ mod arrayvec_like {
         pub fn clear(&mut self) {
             self.len = 0;
         }
-    }
-
-    impl std::ops::Deref for Pending {
-        type Target = [[Vec3; 3]];
-        fn deref(&self) -> &Self::Target {
-            &self.triangles[..self.len]
+        /// The triangles, with the unused lanes repeating the last one.
+        pub fn soa(&self) -> [[[f32; 4]; 3]; 3] {
+            let mut v = self.vertices;
+            for lane in self.len..4 {
+                for corner in v.iter_mut() {
+                    for axis in corner.iter_mut() {
+                        axis[lane] = axis[self.len - 1];
+                    }
+                }
+            }
+            v
         }
     }
 }
