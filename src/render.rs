@@ -130,12 +130,6 @@ pub struct RenderOutput {
     pub stop: StopReason,
 }
 
-impl RenderOutput {
-    pub fn mrays_per_second(&self) -> f64 {
-        self.stats.mrays_per_second()
-    }
-}
-
 /// What the caller can watch and steer during a progressive render.
 pub struct Hooks<'a> {
     /// Called after each tile with the number of pixel samples it added.

@@ -29,6 +29,13 @@ pub(super) const BOX_EXPANSION: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (
 /// depend on the visiting order. About 32 ulps: it costs nothing measurable.
 pub(super) const PRUNE_SLACK: f32 = 1.0 + 1.0 / (1 << 18) as f32;
 
+/// `1 / d`, but a huge finite value instead of infinity for a zero direction component, so that
+/// `(plane - origin) * inv_dir` is 0, not NaN, for an origin lying on a slab plane.
+#[inline]
+pub(super) fn safe_reciprocal(d: f32) -> f32 {
+    if d.abs() < 1e-30 { 1e30f32.copysign(d) } else { 1.0 / d }
+}
+
 /// Ray constants for the box tests.
 struct BoxRay {
     origin: Vec3,
@@ -37,10 +44,7 @@ struct BoxRay {
 
 impl BoxRay {
     fn new(ray: &Ray) -> Self {
-        // A zero direction component gives a huge finite reciprocal instead of infinity, so that
-        // `(plane - origin) * inv_dir` is 0, not NaN, for an origin lying on a slab plane.
-        let safe_inv = |d: f32| if d.abs() < 1e-30 { 1e30f32.copysign(d) } else { 1.0 / d };
-        BoxRay { origin: ray.origin, inv_dir: Vec3::new(safe_inv(ray.dir.x), safe_inv(ray.dir.y), safe_inv(ray.dir.z)) }
+        BoxRay { origin: ray.origin, inv_dir: ray.dir.map(safe_reciprocal) }
     }
 
     /// Entry distance into `node`'s box if the ray meets it within `[0, tmax]`.

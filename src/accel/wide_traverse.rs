@@ -9,7 +9,7 @@ use std::mem::MaybeUninit;
 
 use super::build::MAX_DEPTH;
 use super::simd::F32x4;
-use super::traverse::{BOX_EXPANSION, PRUNE_SLACK};
+use super::traverse::{BOX_EXPANSION, PRUNE_SLACK, safe_reciprocal};
 use super::wide::{Bvh4, LEAF_BIT, Node4, TriangleBlock, leaf_blocks};
 use super::{Hit, TraversalStats};
 use crate::geometry::triangle::{CANCELLATION_ERROR, WatertightRay, intersect_triangle};
@@ -58,11 +58,10 @@ impl BoxRay4 {
     fn new(ray: &Ray) -> Self {
         let d = ray.dir.to_array();
         let o = ray.origin.to_array();
-        let safe_inv = |d: f32| if d.abs() < 1e-30 { 1e30f32.copysign(d) } else { 1.0 / d };
         BoxRay4 {
             near_row: [0, 1, 2].map(|a| if d[a] >= 0.0 { a } else { a + 3 }),
             origin: o.map(F32x4::splat),
-            inv_dir: d.map(|v| F32x4::splat(safe_inv(v))),
+            inv_dir: d.map(|v| F32x4::splat(safe_reciprocal(v))),
         }
     }
 

@@ -111,7 +111,7 @@ fn render_in_pool(args: &RenderArgs, threads: usize) -> Result<u8> {
         options.spp,
         render_ms,
         output.stats.rays,
-        output.mrays_per_second(),
+        output.stats.mrays_per_second(),
         args.output.display()
     );
     if output.film.discarded > 0 {
@@ -137,7 +137,7 @@ fn render_in_pool(args: &RenderArgs, threads: usize) -> Result<u8> {
             "build_ms": build_ms,
             "render_ms": render_ms,
             "rays": output.stats.rays,
-            "mrays_per_s": output.mrays_per_second(),
+            "mrays_per_s": output.stats.mrays_per_second(),
             "stop": output.stop.describe(),
             "relative_error": output.film.relative_error(),
             "discarded_samples": output.film.discarded,
