@@ -1,0 +1,108 @@
+//! `lumiere bench-bvh`: build and traversal measurements on the benchmark scenes, as Markdown.
+
+use std::time::Instant;
+
+use crate::bench::bvh::{build, median_seconds, mesh_bytes, mismatches, peak_rss_mib, trace, work_per_ray};
+use crate::bench::rays::make_ray_sets;
+use crate::bench::scenes::BenchScene;
+use lumiere::accel::BuildPreset;
+use lumiere::image_io::write_atomically;
+use lumiere::world::World;
+use lumiere::{Error, Result};
+
+use super::args::BenchBvhArgs;
+use super::export::export_ray_sets;
+use super::pool;
+
+pub fn run(args: &BenchBvhArgs) -> Result<()> {
+    let scenes: Vec<BenchScene> = args
+        .scenes
+        .split(',')
+        .map(|name| {
+            BenchScene::by_name(name.trim()).ok_or_else(|| {
+                Error::invalid(format!("unknown benchmark scene '{name}' (cornell, bunny, bunny-1m, staircase)"))
+            })
+        })
+        .collect::<Result<_>>()?;
+    let threads: Vec<usize> = args.threads.clone();
+    let mut builds = Vec::new();
+    let mut traces = Vec::new();
+    let mut json = Vec::new();
+    for bench in &scenes {
+        let start = Instant::now();
+        let scene = bench.load(&args.scenes_dir)?;
+        let load_ms = start.elapsed().as_secs_f64() * 1e3;
+        let camera = bench.camera()?;
+        let triangles = scene.mesh.triangle_count();
+        let mesh = mesh_bytes(&scene.mesh);
+        eprintln!("{}: {triangles} triangles loaded in {load_ms:.0} ms", bench.name);
+
+        // Reference structures and ray sets, built once.
+        let (binary, wide) = build(&scene.mesh, BuildPreset::Default);
+        let costs: Vec<String> =
+            BuildPreset::ALL.iter().map(|&p| format!("{:.1}", build(&scene.mesh, p).0.sah_cost())).collect();
+        let world = World { scene, bvh: wide };
+        let sets = make_ray_sets(&world, &camera, args.seed);
+        let bytes = mesh + world.bvh.memory_bytes();
+        for &n in &threads {
+            let pool = pool(n)?;
+            let build_ms = 1e3
+                * pool
+                    .install(|| median_seconds(args.repeats, || drop(build(&world.scene.mesh, BuildPreset::Default))));
+            builds.push(format!(
+                "| {} | {} | {triangles} | {load_ms:.0} | {build_ms:.0} | {} / {} | {} | {:.1} | {:.0} |",
+                bench.name,
+                n,
+                binary.nodes().len(),
+                world.bvh.nodes().len(),
+                costs.join(" / "),
+                bytes as f64 / triangles as f64,
+                peak_rss_mib().unwrap_or(f64::NAN),
+            ));
+            json.push(serde_json::json!({"scene": bench.name, "threads": n, "what": "build", "triangles": triangles, "load_ms": load_ms, "build_ms": build_ms, "binary_nodes": binary.nodes().len(), "wide_nodes": world.bvh.nodes().len(), "bytes_per_triangle": bytes as f64 / triangles as f64}));
+        }
+        for set in &sets {
+            let wrong = mismatches(&binary, &world.bvh, set);
+            let (nodes, blocks) = work_per_ray(&world.bvh, set);
+            for &n in &threads {
+                let seconds = pool(n)?.install(|| median_seconds(args.repeats, || trace(&world.bvh, set)));
+                let mrays = set.rays.len() as f64 / seconds / 1e6;
+                traces.push(format!(
+                    "| {} | {} {} | {} | {} | {:.1} | {mrays:.1} | {nodes:.1} | {blocks:.1} | {wrong} |",
+                    bench.name,
+                    set.kind,
+                    set.query.name(),
+                    n,
+                    set.rays.len(),
+                    seconds * 1e3,
+                ));
+                json.push(serde_json::json!({"scene": bench.name, "threads": n, "what": "trace", "kind": set.kind, "query": set.query.name(), "rays": set.rays.len(), "median_s": seconds, "mrays_per_s": mrays, "nodes_per_ray": nodes, "blocks_per_ray": blocks, "mismatches": wrong}));
+                if wrong != 0 {
+                    eprintln!(
+                        "lumiere: warning: {} {} {}: {wrong} rays differ from the scalar reference",
+                        bench.name,
+                        set.kind,
+                        set.query.name()
+                    );
+                }
+            }
+        }
+        if let Some(dir) = &args.export_rays {
+            export_ray_sets(&dir.join(bench.name), &world, &sets)?;
+        }
+    }
+    println!(
+        "| scene | threads | triangles | load ms | build ms | nodes binary / 4-wide | SAH fast / default / high | bytes/tri | peak RSS MiB |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|");
+    builds.iter().for_each(|row| println!("{row}"));
+    println!();
+    println!("| scene | rays | threads | count | median ms | Mrays/s | nodes/ray | blocks/ray | mismatches |");
+    println!("|---|---|---|---|---|---|---|---|---|");
+    traces.iter().for_each(|row| println!("{row}"));
+    if let Some(path) = &args.json {
+        let text = serde_json::to_string_pretty(&json).map_err(|e| Error::invalid(format!("json: {e}")))?;
+        write_atomically(path, text.as_bytes())?;
+    }
+    Ok(())
+}

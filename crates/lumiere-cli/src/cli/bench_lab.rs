@@ -1,0 +1,124 @@
+//! `lumiere bench`: the lab's timing table on the built-in scene, serial and parallel, beside the
+//! lab's own figures.
+
+use crate::bench::bvh::median_seconds;
+use lumiere::image_io::write_atomically;
+use lumiere::integrators::Mode;
+use lumiere::render::{RenderOptions, render};
+use lumiere::scene::camera::Camera;
+use lumiere::scene::{Scene, builtin};
+use lumiere::world::World;
+use lumiere::{Error, Result};
+
+use super::args::BenchLabArgs;
+use super::pool;
+
+/// One row of the lab's table: what was rendered and the lab's serial and parallel milliseconds.
+struct LabRow {
+    label: &'static str,
+    mode: Mode,
+    samples: u32,
+    lab_serial_ms: f64,
+    lab_parallel_ms: f64,
+}
+
+const LAB_ROWS: [LabRow; 7] = [
+    LabRow { label: "hard shadows", mode: Mode::Shadows, samples: 1, lab_serial_ms: 545.0, lab_parallel_ms: 272.0 },
+    LabRow {
+        label: "soft shadows N=16",
+        mode: Mode::Direct,
+        samples: 16,
+        lab_serial_ms: 5902.0,
+        lab_parallel_ms: 2891.0,
+    },
+    LabRow {
+        label: "soft shadows N=64",
+        mode: Mode::Direct,
+        samples: 64,
+        lab_serial_ms: 22697.0,
+        lab_parallel_ms: 11506.0,
+    },
+    LabRow {
+        label: "soft shadows N=256",
+        mode: Mode::Direct,
+        samples: 256,
+        lab_serial_ms: 89203.0,
+        lab_parallel_ms: 46847.0,
+    },
+    LabRow {
+        label: "AO N=16",
+        mode: Mode::AmbientOcclusion,
+        samples: 16,
+        lab_serial_ms: 5295.0,
+        lab_parallel_ms: 1817.0,
+    },
+    LabRow {
+        label: "AO N=64",
+        mode: Mode::AmbientOcclusion,
+        samples: 64,
+        lab_serial_ms: 19188.0,
+        lab_parallel_ms: 6954.0,
+    },
+    LabRow {
+        label: "AO N=256",
+        mode: Mode::AmbientOcclusion,
+        samples: 256,
+        lab_serial_ms: 71066.0,
+        lab_parallel_ms: 26914.0,
+    },
+];
+
+pub fn run(args: &BenchLabArgs) -> Result<()> {
+    let (width, height, repeats) =
+        if args.quick { (256, 192, 1) } else { (builtin::WIDTH, builtin::HEIGHT, args.repeats) };
+    let world = World::new(Scene::builtin()?, Default::default());
+    let camera = Camera::from_orbiter(&builtin::cornell_orbiter()?, width, height);
+    let all_cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let serial = pool(1)?;
+    let parallel = pool(all_cores)?;
+
+    println!(
+        "| image ({width}x{height}) | lab serial ms | serial ms | speed-up | lab parallel ms | parallel ms ({all_cores} threads) | speed-up | rays | Mrays/s (parallel) |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|");
+    let mut json = Vec::new();
+    for row in &LAB_ROWS {
+        let options = RenderOptions::new(row.mode, row.samples);
+        let mut rays = 0;
+        let mut time = |pool: &rayon::ThreadPool| -> Result<f64> {
+            let mut failure = None;
+            let seconds = pool.install(|| {
+                median_seconds(repeats, || match render(&world, &camera, &options, &|_| {}) {
+                    Ok(out) => rays = out.stats.rays,
+                    Err(e) => failure = Some(e),
+                })
+            });
+            failure.map_or(Ok(seconds * 1e3), Err)
+        };
+        let serial_ms = time(&serial)?;
+        let parallel_ms = time(&parallel)?;
+        let mrays = rays as f64 / parallel_ms / 1e3;
+        println!(
+            "| {} | {:.0} | {serial_ms:.0} | {:.1}x | {:.0} | {parallel_ms:.0} | {:.1}x | {rays} | {mrays:.1} |",
+            row.label,
+            row.lab_serial_ms,
+            row.lab_serial_ms / serial_ms,
+            row.lab_parallel_ms,
+            row.lab_parallel_ms / parallel_ms
+        );
+        json.push(serde_json::json!({
+            "image": row.label, "mode": row.mode.name(), "samples": row.samples, "width": width, "height": height,
+            "repeats": repeats, "lab_serial_ms": row.lab_serial_ms, "serial_ms": serial_ms,
+            "lab_parallel_ms": row.lab_parallel_ms, "parallel_ms": parallel_ms, "threads": all_cores,
+            "rays": rays, "mrays_per_s": mrays,
+        }));
+    }
+    if args.quick {
+        println!("\n(--quick: {width}x{height}, one run per row; the lab's figures are for 1024x768.)");
+    }
+    if let Some(path) = &args.json {
+        let text = serde_json::to_string_pretty(&json).map_err(|e| Error::invalid(format!("json: {e}")))?;
+        write_atomically(path, text.as_bytes())?;
+    }
+    Ok(())
+}

@@ -1,0 +1,353 @@
+//! The `lumiere` binary end to end: the lab's modes on the built-in scene, determinism across thread
+//! counts, statistics, and a clear error (exit code 2, no output file) for every bad input.
+
+use std::fs;
+use std::path::Path;
+use std::process::{Command, Output};
+
+use crate::common::TempDir;
+
+fn lumiere(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_lumiere")).args(args).output().expect("the binary runs")
+}
+
+fn stderr(output: &Output) -> String {
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+/// Reads a PFM written by lumiere into rows from the top, as (width, height, pixels).
+fn read_pfm(path: &Path) -> (usize, usize, Vec<[f32; 3]>) {
+    let bytes = fs::read(path).unwrap();
+    let mut header_end = 0;
+    let mut newlines = 0;
+    while newlines < 3 {
+        newlines += usize::from(bytes[header_end] == b'\n');
+        header_end += 1;
+    }
+    let header = std::str::from_utf8(&bytes[..header_end]).unwrap();
+    let mut fields = header.split_whitespace().skip(1);
+    let width: usize = fields.next().unwrap().parse().unwrap();
+    let height: usize = fields.next().unwrap().parse().unwrap();
+    let floats: Vec<f32> =
+        bytes[header_end..].chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect();
+    let mut pixels = vec![[0.0; 3]; width * height];
+    for row in 0..height {
+        for x in 0..width {
+            let src = 3 * ((height - 1 - row) * width + x);
+            pixels[row * width + x] = [floats[src], floats[src + 1], floats[src + 2]];
+        }
+    }
+    (width, height, pixels)
+}
+
+fn assert_rgb(actual: [f32; 3], expected: [f32; 3], what: &str) {
+    let close = actual.iter().zip(expected).all(|(a, e)| (a - e).abs() < 1e-5);
+    assert!(close, "{what}: got {actual:?}, expected {expected:?}");
+}
+
+#[test]
+fn materials_mode_shows_the_walls_and_the_light_with_their_kd() {
+    let dir = TempDir::new("materials");
+    let out = dir.path("m.pfm");
+    let run = lumiere(&["render", "--mode", "materials", "-o", out.to_str().unwrap()]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let (w, h, px) = read_pfm(&out);
+    assert_eq!((w, h), (1024, 768));
+    assert_rgb(px[384 * w + 20], [0.63, 0.065, 0.05], "red left wall");
+    assert_rgb(px[200 * w + 900], [0.14, 0.45, 0.091], "green right wall");
+    assert_rgb(px[100 * w + 400], [0.725, 0.71, 0.68], "back wall");
+
+    // Looking straight up from the floor, the centre pixel sees the light (Kd 0.78).
+    let up = dir.path("up.pfm");
+    let args = ["render", "--mode", "materials", "--size", "64x48", "--eye", "0,0.1,0", "--target", "0,1,0"];
+    let run = lumiere(&[&args[..], &["--up", "0,0,1", "-o", up.to_str().unwrap()]].concat());
+    assert!(run.status.success(), "{}", stderr(&run));
+    let (w, _, px) = read_pfm(&up);
+    assert_rgb(px[24 * w + 32], [0.78, 0.78, 0.78], "light seen from below");
+}
+
+#[test]
+fn hits_mode_is_white_on_geometry_and_black_on_background() {
+    let dir = TempDir::new("hits");
+    let out = dir.path("h.pfm");
+    // From outside the box, looking at it from the side: the box is hit, the sky above it is not.
+    let run = lumiere(&[
+        "render",
+        "--mode",
+        "hits",
+        "--size",
+        "80x60",
+        "--eye",
+        "0,1,8",
+        "--target",
+        "0,1,0",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let (w, _, px) = read_pfm(&out);
+    assert_rgb(px[30 * w + 40], [1.0; 3], "centre hits the box");
+    assert_rgb(px[2 * w + 2], [0.0; 3], "corner sees the background");
+    assert!(px.iter().all(|p| p[0] == 0.0 || p[0] == 1.0), "hits is a pure mask");
+}
+
+#[test]
+fn shadows_mode_lights_the_floor_and_is_black_behind_the_tall_box() {
+    let dir = TempDir::new("shadows");
+    let out = dir.path("s.pfm");
+    let run = lumiere(&["render", "--mode", "shadows", "-o", out.to_str().unwrap()]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let (w, _, px) = read_pfm(&out);
+    // Floor between the tall box and the red wall: both light centroids hidden by the tall box.
+    assert_rgb(px[600 * w + 150], [0.0; 3], "floor in the tall box's shadow");
+    // Open floor in front of the boxes is lit, with the floor's colour balance (Kd 0.725 0.71 0.68).
+    let lit = px[740 * w + 400];
+    assert!(lit[0] > 0.1 && lit[0] > lit[2], "lit floor {lit:?}");
+    assert!((lit[1] / lit[0] - 0.71 / 0.725).abs() < 1e-4, "lit floor ratio {lit:?}");
+
+    // Seen directly, the light shows its emission Ke = 100.
+    let up = dir.path("up.pfm");
+    let run = lumiere(&[
+        "render",
+        "--size",
+        "64x48",
+        "--eye",
+        "0,0.1,0",
+        "--target",
+        "0,1,0",
+        "--up",
+        "0,0,1",
+        "-o",
+        up.to_str().unwrap(),
+    ]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let (w, _, px) = read_pfm(&up);
+    assert_rgb(px[24 * w + 32], [100.0; 3], "light seen directly");
+}
+
+#[test]
+fn thread_count_does_not_change_the_bytes() {
+    let dir = TempDir::new("threads");
+    let one = dir.path("one.png");
+    let two = dir.path("two.png");
+    for (threads, out) in [("1", &one), ("2", &two)] {
+        let run = lumiere(&["render", "--mode", "shadows", "--threads", threads, "-o", out.to_str().unwrap()]);
+        assert!(run.status.success(), "{}", stderr(&run));
+    }
+    assert_eq!(fs::read(&one).unwrap(), fs::read(&two).unwrap());
+}
+
+#[test]
+fn stats_json_has_the_promised_fields() {
+    let dir = TempDir::new("stats");
+    let stats = dir.path("stats.json");
+    let out = dir.path("r.png");
+    let run = lumiere(&[
+        "render",
+        "--mode",
+        "hits",
+        "--size",
+        "32x24",
+        "-o",
+        out.to_str().unwrap(),
+        "--stats-json",
+        stats.to_str().unwrap(),
+    ]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let json: serde_json::Value = serde_json::from_slice(&fs::read(&stats).unwrap()).unwrap();
+    for key in [
+        "mode",
+        "width",
+        "height",
+        "samples",
+        "threads",
+        "triangles",
+        "load_ms",
+        "build_ms",
+        "render_ms",
+        "rays",
+        "mrays_per_s",
+    ] {
+        assert!(json.get(key).is_some(), "missing {key} in {json}");
+    }
+    assert_eq!(json["mode"], "hits");
+    assert_eq!(json["triangles"], 32);
+    assert_eq!(json["rays"], 32 * 24);
+    assert!(stderr(&run).contains("Mrays/s"), "closing line: {}", stderr(&run));
+}
+
+#[test]
+fn mcguire_box_renders_with_the_issue_camera() {
+    let Some(scene) = crate::common::shared_scene("cornell-mcguire/CornellBox-Original.obj") else { return };
+    let scene = scene.to_str().unwrap();
+    let dir = TempDir::new("mcguire");
+    let out = dir.path("m.pfm");
+    let run = lumiere(&[
+        "render",
+        scene,
+        "--size",
+        "64x64",
+        "--eye",
+        "0,1,3.9",
+        "--target",
+        "0,1,0",
+        "--up",
+        "0,1,0",
+        "--fov",
+        "45",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let (w, _, px) = read_pfm(&out);
+    // The floor in front of the boxes is lit by the warm light (Ke 17 12 4): red > green > blue.
+    let floor = px[55 * w + 18];
+    assert!(floor[0] > floor[1] && floor[1] > floor[2] && floor[2] > 0.0, "floor {floor:?}");
+}
+
+/// Runs a command that must fail: exit code 2, a one-line message containing `expected`, no output file.
+fn assert_refused(dir: &TempDir, args: &[&str], expected: &str) {
+    let out = dir.path("out.png");
+    let _ = fs::remove_file(&out);
+    let all: Vec<&str> = args.iter().copied().chain(["-o", out.to_str().unwrap()]).collect();
+    let run = lumiere(&all);
+    let message = stderr(&run);
+    assert_eq!(run.status.code(), Some(2), "{args:?}: {message}");
+    assert!(message.contains(expected), "{args:?}: expected '{expected}' in: {message}");
+    assert!(!message.contains("panicked"), "{args:?}: {message}");
+    assert!(!out.exists(), "{args:?} left an output file");
+}
+
+#[test]
+fn bad_inputs_give_a_clear_error_and_no_file() {
+    let dir = TempDir::new("bad");
+    let missing = dir.path("missing.obj");
+    assert_refused(&dir, &["render", missing.to_str().unwrap()], "missing.obj");
+
+    let bad_number = dir.write("bad_number.obj", "v 0 0 0\nv 1 0 0\nv 0 x 0\nf 1 2 3\n");
+    assert_refused(&dir, &["render", bad_number.to_str().unwrap()], "bad_number.obj:3");
+
+    let out_of_range = dir.write("range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n\nf 1 2 4\n");
+    assert_refused(&dir, &["render", out_of_range.to_str().unwrap()], "range.obj:5");
+
+    let nan = dir.write("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n");
+    assert_refused(&dir, &["render", nan.to_str().unwrap()], "nan.obj:2");
+    let inf = dir.write("inf.obj", "v 0 0 0\nv 1 0 0\nv 0 inf 0\nf 1 2 3\n");
+    assert_refused(&dir, &["render", inf.to_str().unwrap()], "inf.obj:3");
+
+    assert_refused(&dir, &["render", "--size", "0x768"], "no pixels");
+    assert_refused(&dir, &["render", "--size", "banana"], "WIDTHxHEIGHT");
+    assert_refused(&dir, &["render", "--samples", "0"], "samples");
+    assert_refused(&dir, &["render", "--mode", "teapot"], "teapot");
+    assert_refused(&dir, &["render", "--eye", "0,0,nan", "--target", "0,0,1"], "finite");
+
+    let unreadable_orbiter = dir.path("no_such_orbiter.txt");
+    assert_refused(&dir, &["render", "--orbiter", unreadable_orbiter.to_str().unwrap()], "no_such_orbiter.txt");
+
+    // Unwritable output paths: a directory that does not exist, an unsupported extension.
+    for (path, expected) in [("/nonexistent-dir/x.png", "nonexistent-dir"), ("out.jpg", ".png")] {
+        let run = lumiere(&["render", "--mode", "hits", "-o", path]);
+        assert_eq!(run.status.code(), Some(2), "{}", stderr(&run));
+        assert!(stderr(&run).contains(expected), "{}", stderr(&run));
+        assert!(!Path::new(path).exists());
+    }
+    assert_eq!(dir.entries(), ["bad_number.obj", "inf.obj", "nan.obj", "range.obj"]);
+}
+
+#[test]
+fn monte_carlo_modes_render_and_are_deterministic() {
+    let dir = TempDir::new("mc");
+    for (mode, extra) in
+        [("direct", &["--sampler", "sobol"][..]), ("ao", &["--spp", "2"][..]), ("ao", &["--ao-distance", "0.3"][..])]
+    {
+        let mut outputs = Vec::new();
+        for threads in ["1", "2"] {
+            let out = dir.path(&format!("{mode}-{threads}.pfm"));
+            let args = [
+                "render",
+                "--mode",
+                mode,
+                "--samples",
+                "8",
+                "--size",
+                "64x48",
+                "--threads",
+                threads,
+                "-o",
+                out.to_str().unwrap(),
+            ];
+            let run = lumiere(&[&args[..], extra].concat());
+            assert!(run.status.success(), "{mode} {extra:?}: {}", stderr(&run));
+            outputs.push(fs::read(&out).unwrap());
+        }
+        assert_eq!(outputs[0], outputs[1], "{mode} {extra:?}: thread count changed the image");
+        let (_, _, px) = read_pfm(&dir.path(&format!("{mode}-1.pfm")));
+        assert!(px.iter().all(|p| p.iter().all(|c| c.is_finite() && *c >= 0.0)));
+        assert!(px.iter().any(|p| p[0] > 0.0), "{mode}: black image");
+    }
+}
+
+#[test]
+fn staircase_emission_turns_many_small_emitters_into_lights() {
+    let Some(scene) = crate::common::shared_scene("staircase/staircase.obj.gz") else { return };
+    let scene = scene.to_str().unwrap();
+    let dir = TempDir::new("stairs");
+    let out = dir.path("s.pfm");
+    let stats = dir.path("s.json");
+    let camera = [
+        "--eye",
+        "0.0324209,1.52673,4.88197",
+        "--target",
+        "0.0247749,1.571785,3.883015",
+        "--up",
+        "0.000344842,0.998984,0.0450537",
+        "--fov",
+        "58.54",
+    ];
+    let args = [
+        "render",
+        scene,
+        "--mode",
+        "direct",
+        "--light-sampling",
+        "power",
+        "--emission",
+        "Emission=5,5,5",
+        "--samples",
+        "4",
+        "--size",
+        "36x64",
+    ];
+    let run = lumiere(
+        &[&args[..], &camera[..], &["-o", out.to_str().unwrap(), "--stats-json", stats.to_str().unwrap()]].concat(),
+    );
+    assert!(run.status.success(), "{}", stderr(&run));
+    let json: serde_json::Value = serde_json::from_slice(&fs::read(&stats).unwrap()).unwrap();
+    assert!(json["lights"].as_u64().unwrap() > 6000, "lights: {}", json["lights"]);
+    let (_, _, px) = read_pfm(&out);
+    assert!(px.iter().all(|p| p.iter().all(|c| c.is_finite())));
+    assert!(px.iter().filter(|p| p[0] > 0.0).count() > px.len() / 4, "mostly black");
+
+    let unknown = lumiere(&[
+        "render",
+        scene,
+        "--emission",
+        "NoSuchMaterial=1,1,1",
+        "--size",
+        "8x8",
+        "-o",
+        dir.path("u.png").to_str().unwrap(),
+    ]);
+    assert_eq!(unknown.status.code(), Some(2));
+    assert!(stderr(&unknown).contains("NoSuchMaterial"), "{}", stderr(&unknown));
+}
+
+#[test]
+fn lab_bench_quick_prints_every_row() {
+    let run = lumiere(&["bench", "--quick"]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let table = String::from_utf8_lossy(&run.stdout);
+    for row in ["hard shadows", "soft shadows N=16", "soft shadows N=256", "AO N=16", "AO N=256"] {
+        assert!(table.contains(&format!("| {row} |")), "missing {row}:\n{table}");
+    }
+}

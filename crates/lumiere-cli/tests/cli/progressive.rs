@@ -1,0 +1,295 @@
+//! Long renders: progressive passes, budgets, interruption, checkpoint and resume, and images that
+//! stay finite on degenerate input.
+
+use std::fs;
+use std::process::{Child, Command, Output, Stdio};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use lumiere::film::Film;
+use lumiere::integrators::Mode;
+use lumiere::render::{Hooks, RenderOptions, RenderStats, StopReason, render, render_progressive};
+use lumiere::scene::camera::Camera;
+use lumiere::scene::{Scene, builtin};
+use lumiere::world::World;
+
+use crate::common::TempDir;
+
+fn lumiere(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_lumiere")).args(args).output().expect("the binary runs")
+}
+
+fn spawn(args: &[&str]) -> Child {
+    Command::new(env!("CARGO_BIN_EXE_lumiere")).args(args).stderr(Stdio::piped()).spawn().expect("the binary runs")
+}
+
+fn signal(child: &Child, name: &str) {
+    let status = Command::new("kill").args([&format!("-{name}"), &child.id().to_string()]).status().unwrap();
+    assert!(status.success());
+}
+
+fn stderr(output: &Output) -> String {
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+fn small_world() -> (World, Camera) {
+    let world = World::new(Scene::builtin().unwrap(), Default::default());
+    let camera = Camera::from_orbiter(&builtin::cornell_orbiter().unwrap(), 48, 36);
+    (world, camera)
+}
+
+/// A render stopped after S passes holds exactly the bits of one asked for S samples.
+#[test]
+fn stopping_at_s_samples_equals_asking_for_s() {
+    let (world, camera) = small_world();
+    let options = RenderOptions { spp: 20, ..RenderOptions::new(Mode::Direct, 4) };
+    let cancel = AtomicBool::new(false);
+    let mut passes = 0;
+    let mut pass_done = |film: &Film, _: &RenderStats| {
+        passes += 1;
+        if film.samples == 3 {
+            cancel.store(true, Ordering::Relaxed);
+        }
+        Ok(())
+    };
+    let hooks = Hooks { progress: &|_| {}, pass_done: &mut pass_done, cancel: &cancel };
+    let film = Film::new(camera.width, camera.height).unwrap();
+    let stopped = render_progressive(&world, &camera, &options, film, RenderStats::default(), hooks).unwrap();
+    assert_eq!((stopped.stop, stopped.film.samples, passes), (StopReason::Interrupted, 3, 3));
+
+    let asked = render(&world, &camera, &RenderOptions { spp: 3, ..options.clone() }, &|_| {}).unwrap();
+    assert_eq!(asked.stop, StopReason::Completed);
+    assert_eq!(stopped.image, asked.image);
+    assert_eq!(stopped.film, asked.film);
+}
+
+#[test]
+fn noise_target_stops_early_with_the_error_reached() {
+    let (world, camera) = small_world();
+    let options =
+        RenderOptions { spp: 10_000, noise_target: Some(0.05), ..RenderOptions::new(Mode::AmbientOcclusion, 8) };
+    let out = render(&world, &camera, &options, &|_| {}).unwrap();
+    assert_eq!(out.stop, StopReason::NoiseTarget);
+    assert!(out.film.samples < 10_000);
+    assert!(out.film.relative_error().unwrap() <= 0.05);
+    // One pass fewer would not have been enough (the stop is the first pass below the target).
+    let fewer =
+        render(&world, &camera, &RenderOptions { spp: out.film.samples - 1, noise_target: None, ..options }, &|_| {});
+    assert!(fewer.unwrap().film.relative_error().unwrap() > 0.05);
+}
+
+#[test]
+fn time_budget_stops_after_the_crossing_pass_and_says_why() {
+    let dir = TempDir::new("time");
+    let out = dir.arg("t.png");
+    let start = Instant::now();
+    let run = lumiere(&[
+        "render",
+        "--mode",
+        "ao",
+        "--samples",
+        "8",
+        "--spp",
+        "100000",
+        "--size",
+        "64x48",
+        "--time",
+        "300ms",
+        "-o",
+        &out,
+    ]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    assert!(start.elapsed() < Duration::from_secs(20));
+    let message = stderr(&run);
+    assert!(message.contains("time budget reached after"), "{message}");
+    assert!(fs::metadata(&out).unwrap().len() > 0);
+}
+
+/// SIGINT and SIGTERM: the completed samples are written, the summary says so, exit code 3.
+#[test]
+fn interruption_writes_the_completed_samples_and_exits_3() {
+    let dir = TempDir::new("interrupt");
+    for name in ["INT", "TERM"] {
+        let out = dir.arg(&format!("{name}.png"));
+        let stats = dir.arg(&format!("{name}.json"));
+        let child = spawn(&[
+            "render",
+            "--mode",
+            "ao",
+            "--samples",
+            "16",
+            "--spp",
+            "100000",
+            "--size",
+            "64x48",
+            "--stats-json",
+            &stats,
+            "-o",
+            &out,
+        ]);
+        std::thread::sleep(Duration::from_millis(700));
+        signal(&child, name);
+        let run = child.wait_with_output().unwrap();
+        assert_eq!(run.status.code(), Some(3), "{name}: {}", stderr(&run));
+        assert!(stderr(&run).contains("interrupted after"), "{}", stderr(&run));
+        let json: serde_json::Value = serde_json::from_slice(&fs::read(&stats).unwrap()).unwrap();
+        assert!(json["spp"].as_u64().unwrap() >= 1, "{json}");
+        assert!(fs::metadata(&out).unwrap().len() > 0);
+    }
+    let leftovers: Vec<_> = fs::read_dir(&dir.0).unwrap().map(|e| e.unwrap().file_name()).collect();
+    assert_eq!(leftovers.len(), 4, "temporary files left: {leftovers:?}");
+}
+
+/// SIGKILL at several moments, then resume until done: the same bytes as a render never interrupted.
+#[test]
+fn killed_and_resumed_renders_give_identical_bytes() {
+    let dir = TempDir::new("kill");
+    // About 1.5 s of work, so that every kill point lands mid-render.
+    let args = ["render", "--mode", "direct", "--samples", "8", "--spp", "96", "--size", "96x72", "--sampler", "sobol"];
+    let reference = dir.arg("reference.pfm");
+    let run = lumiere(&[&args[..], &["-o", &reference]].concat());
+    assert!(run.status.success(), "{}", stderr(&run));
+    let expected = fs::read(&reference).unwrap();
+
+    let mut total_kills = 0;
+    for (attempt, delay_ms) in [40u64, 150, 330, 520].into_iter().enumerate() {
+        let out = dir.arg(&format!("resumed{attempt}.pfm"));
+        let checkpoint = dir.arg(&format!("run{attempt}.ckpt"));
+        let mut kills = 0;
+        loop {
+            let mut command = vec!["--checkpoint", &checkpoint, "-o", &out];
+            if fs::metadata(&checkpoint).is_ok() {
+                command.extend(["--resume", &checkpoint]);
+            }
+            let mut child = spawn(&[&args[..], &command].concat());
+            if kills < 3 {
+                std::thread::sleep(Duration::from_millis(delay_ms * (kills + 1)));
+                if child.try_wait().unwrap().is_none() {
+                    signal(&child, "KILL");
+                    let _ = child.wait();
+                    kills += 1;
+                    continue;
+                }
+            }
+            let run = child.wait_with_output().unwrap();
+            assert!(run.status.success(), "{}", stderr(&run));
+            break;
+        }
+        assert_eq!(fs::read(&out).unwrap(), expected, "attempt {attempt} ({kills} kills) differs");
+        total_kills += kills;
+    }
+    assert!(total_kills >= 6, "only {total_kills} kills landed mid-render");
+}
+
+#[test]
+fn resuming_with_other_inputs_or_a_broken_file_is_refused() {
+    let dir = TempDir::new("refuse");
+    let checkpoint = dir.arg("c.ckpt");
+    let out = dir.arg("o.png");
+    let base = ["render", "--mode", "ao", "--samples", "4", "--spp", "2", "--size", "32x24"];
+    let run = lumiere(&[&base[..], &["--checkpoint", &checkpoint, "-o", &out]].concat());
+    assert!(run.status.success(), "{}", stderr(&run));
+
+    let mcguire = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/corpus/seeds/CornellBox-Original.obj");
+    let cases: [(&[&str], &str); 4] = [
+        (&["render", mcguire, "--mode", "ao", "--samples", "4", "--spp", "4", "--size", "32x24"], "different scene"),
+        (&["render", "--mode", "ao", "--samples", "8", "--spp", "4", "--size", "32x24"], "different options"),
+        (
+            &["render", "--mode", "ao", "--samples", "4", "--spp", "4", "--size", "32x24", "--seed", "9"],
+            "different options",
+        ),
+        (
+            &[
+                "render",
+                "--mode",
+                "ao",
+                "--samples",
+                "4",
+                "--spp",
+                "4",
+                "--size",
+                "32x24",
+                "--emission",
+                "floor.001=1,1,1",
+            ],
+            "different scene",
+        ),
+    ];
+    for (args, expected) in cases {
+        let run = lumiere(&[args, &["--resume", &checkpoint, "-o", &dir.arg("x.png")]].concat());
+        assert_eq!(run.status.code(), Some(2), "{args:?}");
+        assert!(stderr(&run).contains(expected), "{args:?}: {}", stderr(&run));
+    }
+    // A truncated checkpoint is refused with a clear message, never a panic.
+    let bytes = fs::read(&checkpoint).unwrap();
+    fs::write(&checkpoint, &bytes[..bytes.len() / 2]).unwrap();
+    let run = lumiere(&[&base[..], &["--resume", &checkpoint, "-o", &out]].concat());
+    assert_eq!(run.status.code(), Some(2));
+    assert!(stderr(&run).contains("not a valid lumiere checkpoint"), "{}", stderr(&run));
+}
+
+#[test]
+fn absurd_sizes_are_refused_before_allocating() {
+    for size in ["100000x100000", "4294967295x4294967295"] {
+        let run = lumiere(&["render", "--size", size, "-o", "/tmp/never-written.png"]);
+        assert_eq!(run.status.code(), Some(2), "{size}: {}", stderr(&run));
+        assert!(stderr(&run).contains("GiB of memory"), "{size}: {}", stderr(&run));
+    }
+}
+
+/// Degenerate input (zero-area and back-facing lights, zero-length normals, coordinates near the
+/// f32 limit, a camera inside geometry) renders finite images in every mode.
+#[test]
+fn degenerate_scenes_render_finite_images() {
+    let dir = TempDir::new("degenerate");
+    let mtl = "newmtl light\nKd 0.5 0.5 0.5\nKe 10 10 10\nnewmtl white\nKd 0.8 0.8 0.8\n";
+    fs::write(dir.0.join("d.mtl"), mtl).unwrap();
+    let obj = "mtllib d.mtl\n\
+        v -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\n\
+        v 0 2 0\nv 0 2 0\nv 1 2 0\n\
+        v -0.5 1 -0.5\nv 0.5 1 -0.5\nv 0 1 0.5\n\
+        v 3e38 0 0\nv -3e38 1 0\nv 0 3e38 3e38\n\
+        vn 0 0 0\n\
+        usemtl white\nf 1//1 2//1 3//1 4//1\nf 11 12 13\n\
+        usemtl light\nf 5 6 7\nf 8 9 10\n";
+    let scene = dir.arg("d.obj");
+    fs::write(&scene, obj).unwrap();
+    let views: [&[&str]; 2] = [&["--eye", "0,3,4", "--target", "0,0,0"], &["--eye", "0,0.5,0", "--target", "0,0.5,-1"]];
+    for mode in ["hits", "materials", "shadows", "direct", "ao"] {
+        for view in views {
+            let out = dir.arg("d.pfm");
+            let stats = dir.arg("d.json");
+            let args = [
+                "render",
+                &scene,
+                "--mode",
+                mode,
+                "--samples",
+                "4",
+                "--size",
+                "24x18",
+                "-o",
+                &out,
+                "--stats-json",
+                &stats,
+            ];
+            let run = lumiere(&[&args[..], view].concat());
+            assert!(run.status.success(), "{mode} {view:?}: {}", stderr(&run));
+            let bytes = fs::read(&out).unwrap();
+            let header = bytes.iter().enumerate().filter(|(_, b)| **b == b'\n').nth(2).unwrap().0 + 1;
+            let floats = bytes[header..].chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap()));
+            assert!(floats.into_iter().all(f32::is_finite), "{mode} {view:?}: non-finite pixel");
+            let json: serde_json::Value = serde_json::from_slice(&fs::read(&stats).unwrap()).unwrap();
+            assert!(json["discarded_samples"].is_u64(), "{json}");
+        }
+    }
+}
+
+#[test]
+fn shipped_scenes_discard_no_samples() {
+    let (world, camera) = small_world();
+    for mode in [Mode::Shadows, Mode::Direct, Mode::AmbientOcclusion] {
+        let out = render(&world, &camera, &RenderOptions { spp: 2, ..RenderOptions::new(mode, 8) }, &|_| {}).unwrap();
+        assert_eq!(out.film.discarded, 0, "{mode:?}");
+    }
+}

@@ -1,0 +1,198 @@
+//! The BVH against brute force on seeded random meshes: same closest triangle, same t, same
+//! occlusion answers, for every build preset; plus the structural validator.
+
+use crate::common::{TestRng, grid_cube};
+use glam::Vec3;
+use lumiere::accel::{BuildPreset, Bvh, Bvh4, Hit, TraversalStats};
+use lumiere::geometry::triangle::{WatertightRay, intersect_triangle, is_degenerate};
+use lumiere::math::Ray;
+
+fn brute_force(positions: &[Vec3], indices: &[[u32; 3]], ray: &Ray) -> Option<Hit> {
+    let wray = WatertightRay::new(ray);
+    let mut best: Option<Hit> = None;
+    for (id, tri) in indices.iter().enumerate() {
+        let [a, b, c] = tri.map(|i| positions[i as usize]);
+        if is_degenerate(a, b, c) {
+            continue;
+        }
+        let tmax = best.map_or(ray.tmax, |b| b.t);
+        if let Some(h) = intersect_triangle(&wray, tmax, a, b, c) {
+            // Equal t: the lower id wins (ids are visited in increasing order, so keep the first).
+            if best.is_none_or(|b| h.t < b.t) {
+                best = Some(Hit { t: h.t, triangle: id as u32, u: h.u, v: h.v });
+            }
+        }
+    }
+    best
+}
+
+/// Kinds of random meshes, each stressing the build differently.
+fn random_mesh(rng: &mut TestRng, kind: usize) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let count = match kind {
+        0 => 0,
+        1 => 1,
+        _ => 1 + rng.below(600),
+    };
+    let scale = if kind == 5 { 1e18 } else { 1.0 };
+    let mut positions = Vec::new();
+    let mut indices = Vec::new();
+    for i in 0..count {
+        let centre = rng.vec3(-10.0, 10.0);
+        let size = rng.range(0.01, 2.0);
+        let mut corners =
+            [centre + rng.vec3(-size, size), centre + rng.vec3(-size, size), centre + rng.vec3(-size, size)];
+        match kind {
+            // Degenerate: zero-area (repeated vertex) and collinear triangles mixed in.
+            3 if i % 3 == 0 => corners[2] = corners[0],
+            3 if i % 3 == 1 => corners[2] = corners[0] + 0.5 * (corners[1] - corners[0]),
+            // Coplanar: everything on the plane z = 1.
+            4 => corners.iter_mut().for_each(|p| p.z = 1.0),
+            // Many overlapping coplanar triangles sharing one centroid (the origin).
+            6 => corners = [Vec3::new(-size, -size, 0.0), Vec3::new(size, -size, 0.0), Vec3::new(0.0, 2.0 * size, 0.0)],
+            _ => {}
+        }
+        let base = positions.len() as u32;
+        positions.extend(corners.iter().map(|&p| p * scale));
+        indices.push([base, base + 1, base + 2]);
+    }
+    (positions, indices)
+}
+
+/// Every preset and every traversal path (binary scalar, 4-wide SIMD, counted variants) must give
+/// brute force's answer bit for bit: same triangle, same t and barycentrics, same occlusion.
+fn check_against_brute_force(positions: &[Vec3], indices: &[[u32; 3]], rays: &[Ray], context: &str) {
+    for preset in BuildPreset::ALL {
+        let bvh = Bvh::build(positions, indices, preset);
+        bvh.validate().unwrap_or_else(|e| panic!("{context} {preset:?}: {e}"));
+        let wide = Bvh4::from_binary(&bvh);
+        let mut stats = TraversalStats::default();
+        for ray in rays {
+            let expected = brute_force(positions, indices, ray);
+            let paths = [
+                ("binary", bvh.intersect(ray), bvh.occluded(ray)),
+                ("wide", wide.intersect(ray), wide.occluded(ray)),
+                ("wide counted", wide.intersect_counted(ray, &mut stats), wide.occluded_counted(ray, &mut stats)),
+            ];
+            for (path, hit, occluded) in paths {
+                assert_eq!(hit, expected, "{context} {preset:?} {path} {ray:?}");
+                assert_eq!(occluded, expected.is_some(), "{context} {preset:?} {path} occlusion {ray:?}");
+            }
+        }
+        assert!(rays.is_empty() || indices.is_empty() || stats.nodes > 0, "{context}: counters count");
+    }
+}
+
+#[test]
+fn random_meshes_match_brute_force_for_every_preset() {
+    let mut rng = TestRng(2024);
+    for mesh_index in 0..350 {
+        let kind = mesh_index % 7;
+        let (positions, indices) = random_mesh(&mut rng, kind);
+        let scale = if kind == 5 { 1e18 } else { 1.0 };
+        let rays: Vec<Ray> = (0..64)
+            .map(|i| {
+                let origin = rng.vec3(-15.0, 15.0) * scale;
+                let mut ray = if i % 2 == 0 && !indices.is_empty() {
+                    // Aim at a random vertex so that many rays hit.
+                    let target = positions[indices[rng.below(indices.len())][0] as usize];
+                    Ray::new(origin, target - origin)
+                } else {
+                    Ray::new(origin, rng.direction())
+                };
+                if i % 5 == 0 {
+                    ray.tmax = rng.range(0.0, 20.0) * scale;
+                }
+                ray
+            })
+            .collect();
+        check_against_brute_force(&positions, &indices, &rays, &format!("mesh {mesh_index} kind {kind}"));
+    }
+}
+
+#[test]
+fn closed_mesh_rays_through_vertices_and_edges_never_leak() {
+    let (positions, indices) = grid_cube(6);
+    let mut rng = TestRng(5);
+    let origin = Vec3::new(0.1, -0.2, 0.05);
+    let mut rays: Vec<Ray> = positions.iter().map(|&p| Ray::new(origin, p - origin)).collect();
+    rays.extend((0..500).map(|_| Ray::new(origin, rng.direction())));
+    for preset in BuildPreset::ALL {
+        let bvh = Bvh::build(&positions, &indices, preset);
+        let wide = Bvh4::from_binary(&bvh);
+        for ray in &rays {
+            assert!(bvh.intersect(ray).is_some() && wide.intersect(ray).is_some(), "{preset:?}: {ray:?} escaped");
+            assert!(bvh.occluded(ray) && wide.occluded(ray), "{preset:?}: {ray:?} escaped");
+        }
+    }
+    check_against_brute_force(&positions, &indices, &rays, "grid cube");
+}
+
+#[test]
+fn sah_cost_is_sane_and_better_presets_are_not_worse() {
+    let (positions, indices) = grid_cube(40);
+    let costs: Vec<f64> = BuildPreset::ALL.iter().map(|&p| Bvh::build(&positions, &indices, p).sah_cost()).collect();
+    assert!(costs.iter().all(|&c| c > 1.0 && c.is_finite()), "{costs:?}");
+    // A single leaf over everything would cost the triangle count; the tree must be far better.
+    assert!(costs[1] < indices.len() as f64 / 20.0, "{costs:?}");
+    assert!(costs[2] <= costs[0] * 1.02, "high quality {} vs fast {}", costs[2], costs[0]);
+}
+
+/// Shared-origin batches (shafts towards a triangle, hemispheres) answer exactly like traversal
+/// for rays away from triangle edges, and agree on all but a vanishing fraction of edge-grazing rays.
+#[test]
+fn origin_batches_agree_with_traversal() {
+    use lumiere::accel::{OriginBatch, Region};
+    let mut rng = TestRng(77);
+    let (mut rays, mut differ, mut batched) = (0usize, 0usize, 0usize);
+    for mesh_index in 0..120 {
+        let (positions, indices) = random_mesh(&mut rng, 2 + mesh_index % 3);
+        let wide = Bvh4::from_binary(&Bvh::build(&positions, &indices, BuildPreset::Default));
+        let mut batch = OriginBatch::default();
+        for _ in 0..8 {
+            let origin = rng.vec3(-12.0, 12.0);
+            let corners = [rng.vec3(-12.0, 12.0), rng.vec3(-12.0, 12.0), rng.vec3(-12.0, 12.0)];
+            let normal = rng.direction();
+            let (region, shaft) = match Region::shaft(origin, corners) {
+                Some(r) if rng.f32() < 0.5 => (r, true),
+                _ => (Region::hemisphere(origin, normal), false),
+            };
+            batch.prepare(&wide, origin, &region);
+            batched += usize::from(batch.candidate_blocks().is_some());
+            for _ in 0..64 {
+                let ray = if shaft {
+                    let (a, b) = (rng.f32(), rng.f32());
+                    let (a, b) = if a + b > 1.0 { (1.0 - a, 1.0 - b) } else { (a, b) };
+                    let target = corners[0] + a * (corners[1] - corners[0]) + b * (corners[2] - corners[0]);
+                    Ray::segment(origin, target)
+                } else {
+                    let d = rng.direction();
+                    Ray::new(origin, if d.dot(normal) < 0.0 { -d } else { d })
+                };
+                rays += 1;
+                differ += usize::from(batch.occluded(&wide, &ray) != wide.occluded(&ray));
+            }
+        }
+    }
+    assert!(batched > 300, "only {batched} batches used candidates");
+    assert!(differ * 10_000 <= rays, "{differ} of {rays} rays differ");
+}
+
+/// A closed mesh seen from inside: no batched ray escapes, through vertices and edges included.
+#[test]
+fn origin_batches_never_leak_through_a_closed_mesh() {
+    use lumiere::accel::{OriginBatch, Region};
+    let (positions, indices) = grid_cube(2);
+    let wide = Bvh4::from_binary(&Bvh::build(&positions, &indices, BuildPreset::Default));
+    let origin = Vec3::new(0.1, -0.2, 0.05);
+    let mut batch = OriginBatch::default();
+    for normal in [Vec3::X, Vec3::NEG_Y, Vec3::new(0.3, 0.4, -0.5).normalize()] {
+        batch.prepare(&wide, origin, &Region::hemisphere(origin, normal));
+        assert!(batch.candidate_blocks().is_some());
+        for &p in &positions {
+            let dir = p - origin;
+            if dir.dot(normal) > 0.0 {
+                assert!(batch.occluded(&wide, &Ray::new(origin, dir)), "ray to vertex {p:?} escaped");
+            }
+        }
+    }
+}

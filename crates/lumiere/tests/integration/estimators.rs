@@ -1,0 +1,191 @@
+//! Monte Carlo estimators against scenes with known answers. Standard errors come from the samples
+//! themselves (independent seeds); seeds are fixed, so a failure reproduces.
+
+use glam::Vec3;
+use lumiere::accel::BuildPreset;
+use lumiere::integrators::{LightSampling, Mode};
+use lumiere::render::{RenderOptions, render};
+use lumiere::sampler::SamplerKind;
+use lumiere::scene::Scene;
+use lumiere::scene::camera::Camera;
+use lumiere::scene::material::Material;
+use lumiere::scene::mesh::TriangleMesh;
+use lumiere::world::World;
+
+/// Builds a scene from quads `(corners, material)`, each split into two triangles `(a,b,c), (a,c,d)`.
+fn scene_of_quads(quads: &[([Vec3; 4], usize)], materials: Vec<Material>) -> World {
+    let mut mesh = TriangleMesh::default();
+    for (corners, material) in quads {
+        let base = mesh.positions.len() as u32;
+        mesh.positions.extend_from_slice(corners);
+        mesh.indices.push([base, base + 1, base + 2]);
+        mesh.indices.push([base, base + 2, base + 3]);
+        mesh.material_ids.extend([*material as u32; 2]);
+    }
+    let scene = Scene::from_obj(lumiere::scene::obj::ObjScene { mesh, materials, warnings: vec![] }, "test".into())
+        .expect("valid test scene");
+    World::new(scene, BuildPreset::Default)
+}
+
+fn diffuse(kd: f32) -> Material {
+    Material { kd: Vec3::splat(kd), ..Material::default_grey("diffuse") }
+}
+
+fn emitter(ke: f32) -> Material {
+    Material { ke: Vec3::splat(ke), ..Material::default_grey("light") }
+}
+
+/// A horizontal quad at height `y`, `[-s, s]^2`, wound so that its normal points down if `down`.
+fn horizontal(y: f32, s: f32, down: bool) -> [Vec3; 4] {
+    let q = [Vec3::new(-s, y, -s), Vec3::new(-s, y, s), Vec3::new(s, y, s), Vec3::new(s, y, -s)];
+    if down { [q[0], q[3], q[2], q[1]] } else { q }
+}
+
+/// The value of the single pixel of a 1x1 image whose ray goes from `eye` to `target`.
+fn estimate(world: &World, eye: Vec3, target: Vec3, options: &RenderOptions) -> f32 {
+    let camera = Camera::look_at(eye, target, Vec3::Y, 1.0, 1, 1).unwrap();
+    render(world, &camera, options, &|_| {}).unwrap().image.pixels[0].x
+}
+
+/// Mean and standard error of the mean over `seeds` independent estimates.
+fn mean_and_error(seeds: u64, mut f: impl FnMut(u64) -> f32) -> (f64, f64) {
+    let values: Vec<f64> = (0..seeds).map(|s| f(s) as f64).collect();
+    let n = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    let variance = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (mean, (variance / n).sqrt())
+}
+
+fn ao_options(samples: u32, seed: u64) -> RenderOptions {
+    RenderOptions { seed, ..RenderOptions::new(Mode::AmbientOcclusion, samples) }
+}
+
+#[test]
+fn ao_of_an_open_plane_is_exactly_one() {
+    let world = scene_of_quads(&[(horizontal(0.0, 10.0, false), 0)], vec![diffuse(0.5)]);
+    let camera = Camera::look_at(Vec3::new(0.0, 3.0, 3.0), Vec3::ZERO, Vec3::Y, 60.0, 16, 12).unwrap();
+    let out = render(&world, &camera, &ao_options(64, 1), &|_| {}).unwrap();
+    // Every sample of every pixel that sees the plane escapes: zero variance.
+    let on_plane: Vec<f32> = out.image.pixels.iter().map(|p| p.x).filter(|&v| v > 0.0).collect();
+    assert!(on_plane.len() > 100);
+    assert!(on_plane.iter().all(|&v| v == 1.0), "{on_plane:?}");
+}
+
+#[test]
+fn ao_inside_a_closed_box_is_exactly_zero() {
+    let (positions, indices) = crate::common::grid_cube(3);
+    let mesh = TriangleMesh { material_ids: vec![0; indices.len()], positions, indices, ..Default::default() };
+    let scene = Scene::from_obj(
+        lumiere::scene::obj::ObjScene { mesh, materials: vec![diffuse(0.5)], warnings: vec![] },
+        "box".into(),
+    )
+    .unwrap();
+    let world = World::new(scene, BuildPreset::Default);
+    let camera = Camera::look_at(Vec3::new(0.1, 0.2, 0.3), Vec3::new(1.0, -0.5, -1.0), Vec3::Y, 90.0, 16, 16).unwrap();
+    let out = render(&world, &camera, &ao_options(64, 2), &|_| {}).unwrap();
+    assert!(out.image.pixels.iter().all(|p| p.x == 0.0));
+}
+
+/// Cosine-weighted visibility at distance `h` from the foot of a wall of height `wall` and (nearly)
+/// infinite length: `1 - F`, with the form factor to an infinite strip `F = (1 - h/sqrt(h^2+H^2))/2`.
+#[test]
+fn ao_beside_a_wall_matches_the_strip_form_factor() {
+    let (h, wall, far) = (1.0f32, 1.0f32, 1.0e4f32);
+    let floor = horizontal(0.0, far, false);
+    let wall_quad =
+        [Vec3::new(h, 0.0, -far), Vec3::new(h, wall, -far), Vec3::new(h, wall, far), Vec3::new(h, 0.0, far)];
+    let world = scene_of_quads(&[(floor, 0), (wall_quad, 0)], vec![diffuse(0.5)]);
+    let expected = 1.0 - 0.5 * (1.0 - h / (h * h + wall * wall).sqrt()) as f64;
+    let (eye, target) = (Vec3::new(-0.5, 2.0, 0.0), Vec3::ZERO);
+    let (mean, error) = mean_and_error(32, |seed| estimate(&world, eye, target, &ao_options(4096, seed)));
+    assert!((mean - expected).abs() < 4.0 * error, "AO {mean} +- {error}, expected {expected}");
+    assert!(error < 0.002, "standard error {error}");
+
+    // The error falls like 1/sqrt(N): 16x the samples, about 4x smaller RMSE.
+    let rmse = |n: u32| {
+        let sq: f64 =
+            (100..132).map(|s| (estimate(&world, eye, target, &ao_options(n, s)) as f64 - expected).powi(2)).sum();
+        (sq / 32.0).sqrt()
+    };
+    let ratio = rmse(64) / rmse(1024);
+    assert!((2.5..6.4).contains(&ratio), "RMSE ratio {ratio} for 16x the samples");
+}
+
+/// Form factor from a point to a parallel square of half-side `a` centred `h` above it: four corner
+/// rectangles, each `(1/pi) X/sqrt(1+X^2) atan(X/sqrt(1+X^2))` with `X = a/h`.
+fn square_form_factor(a: f64, h: f64) -> f64 {
+    let x = a / h;
+    let s = x / (1.0 + x * x).sqrt();
+    4.0 / std::f64::consts::PI * s * s.atan()
+}
+
+fn direct_options(samples: u32, seed: u64, sampler: SamplerKind, light_sampling: LightSampling) -> RenderOptions {
+    RenderOptions { seed, sampler, light_sampling, ..RenderOptions::new(Mode::Direct, samples) }
+}
+
+/// Outgoing radiance of a white Lambertian floor under a square light: `Kd * Le * F`.
+#[test]
+fn direct_light_under_a_square_emitter_matches_the_form_factor() {
+    let (a, h, le, kd) = (0.5f32, 1.0f32, 10.0f32, 0.8f32);
+    let floor = horizontal(0.0, 20.0, false);
+    let light = horizontal(h, a, true);
+    let world = scene_of_quads(&[(floor, 0), (light, 1)], vec![diffuse(kd), emitter(le)]);
+    let expected = (kd * le) as f64 * square_form_factor(a as f64, h as f64);
+    let (eye, target) = (Vec3::new(0.0, 0.4, 3.0), Vec3::ZERO);
+    for sampler in [SamplerKind::Independent, SamplerKind::Sobol] {
+        for light_sampling in [LightSampling::PerLight, LightSampling::Power] {
+            let options = |seed| direct_options(1024, seed, sampler, light_sampling);
+            let (mean, error) = mean_and_error(32, |seed| estimate(&world, eye, target, &options(seed)));
+            let context = format!("{sampler:?} {light_sampling:?}");
+            assert!(
+                (mean - expected).abs() < 4.0 * error.max(1e-4 * expected),
+                "{context}: {mean} +- {error}, expected {expected}"
+            );
+            assert!(error < 0.01 * expected, "{context}: standard error {error}");
+        }
+    }
+}
+
+/// Two lights of different power sharing the square: power sampling spends samples in proportion
+/// and stays unbiased; by symmetry each triangle carries half the form factor.
+#[test]
+fn power_light_sampling_is_unbiased_with_unequal_lights() {
+    let (a, h, kd) = (0.5f32, 1.0f32, 0.8f32);
+    let q = horizontal(h, a, true);
+    let mut mesh = TriangleMesh::default();
+    mesh.positions.extend_from_slice(&horizontal(0.0, 20.0, false));
+    mesh.positions.extend_from_slice(&q);
+    mesh.indices = vec![[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]];
+    mesh.material_ids = vec![0, 0, 1, 2];
+    let materials = vec![diffuse(kd), emitter(5.0), emitter(40.0)];
+    let scene =
+        Scene::from_obj(lumiere::scene::obj::ObjScene { mesh, materials, warnings: vec![] }, "two".into()).unwrap();
+    let world = World::new(scene, BuildPreset::Default);
+    let expected = kd as f64 * (5.0 + 40.0) * 0.5 * square_form_factor(a as f64, h as f64);
+    let options = |seed| direct_options(512, seed, SamplerKind::Independent, LightSampling::Power);
+    let (mean, error) =
+        mean_and_error(48, |seed| estimate(&world, Vec3::new(0.0, 0.4, 3.0), Vec3::ZERO, &options(seed)));
+    assert!((mean - expected).abs() < 4.0 * error, "{mean} +- {error}, expected {expected}");
+}
+
+/// At equal N, the Sobol sampler's error is clearly below the independent sampler's.
+#[test]
+fn sobol_lowers_the_error_of_soft_shadows() {
+    let (a, h, le, kd) = (0.5f32, 1.0f32, 10.0f32, 0.8f32);
+    let world = scene_of_quads(
+        &[(horizontal(0.0, 20.0, false), 0), (horizontal(h, a, true), 1)],
+        vec![diffuse(kd), emitter(le)],
+    );
+    let expected = (kd * le) as f64 * square_form_factor(a as f64, h as f64);
+    let rmse = |sampler| {
+        let sq: f64 = (0..64)
+            .map(|s| {
+                let options = direct_options(64, s, sampler, LightSampling::PerLight);
+                (estimate(&world, Vec3::new(0.0, 0.4, 3.0), Vec3::ZERO, &options) as f64 - expected).powi(2)
+            })
+            .sum();
+        (sq / 64.0).sqrt()
+    };
+    let (independent, sobol) = (rmse(SamplerKind::Independent), rmse(SamplerKind::Sobol));
+    assert!(sobol < 0.75 * independent, "Sobol RMSE {sobol} vs independent {independent}");
+}

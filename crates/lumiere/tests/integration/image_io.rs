@@ -1,0 +1,285 @@
+//! Image writers: values survive a round trip through each format, rows land the right way up, and
+//! writes are atomic (old content fully replaced, nothing left behind on success or failure).
+
+use std::fs;
+use std::path::Path;
+
+use crate::common::TempDir;
+use glam::Vec3;
+use lumiere::Error;
+use lumiere::image_io::{PngEncoding, check_output_path, linear_to_srgb8, write_atomically, write_image};
+
+/// The reference: IEC 61966-2-1 in f64, rounded to nearest.
+fn srgb8_exact(c: f32) -> u8 {
+    let c = f64::from(c).clamp(0.0, 1.0);
+    let v = if c <= 0.0031308 { 12.92 * c } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 };
+    (v * 255.0).round() as u8
+}
+
+/// A gray pixel.
+fn g(c: f32) -> Vec3 {
+    Vec3::splat(c)
+}
+
+fn assert_io_error(result: lumiere::Result<()>, expected_path: &Path) {
+    match result {
+        Err(Error::Io { path, .. }) => assert_eq!(path, expected_path),
+        other => panic!("expected Error::Io for {}, got {other:?}", expected_path.display()),
+    }
+}
+
+fn assert_invalid(result: lumiere::Result<()>, needle: &str) {
+    match result {
+        Err(Error::Invalid(message)) => {
+            assert!(message.contains(needle), "message {message:?} should mention {needle:?}")
+        }
+        other => panic!("expected Error::Invalid mentioning {needle:?}, got {other:?}"),
+    }
+}
+
+#[test]
+fn png_srgb_round_trip_values_and_row_order() {
+    let dir = TempDir::new("png-srgb");
+    let path = dir.path("out.png");
+    let boundary = 0.0031308_f32;
+    let top = [g(0.0), g(1.0), g(0.5), g(boundary)];
+    let bottom = [
+        g(boundary.next_up()),
+        Vec3::new(0.2, 0.04, 0.8),
+        Vec3::new(f32::NAN, f32::INFINITY, -1.0),
+        g(f32::NEG_INFINITY),
+    ];
+    let pixels: Vec<Vec3> = top.iter().chain(&bottom).copied().collect();
+    write_image(&path, 4, 2, &pixels, PngEncoding::Srgb).expect("write png");
+
+    let img = image::open(&path).expect("decode png").to_rgb8();
+    assert_eq!(img.dimensions(), (4, 2));
+    let px = |x, y| img.get_pixel(x, y).0;
+    assert_eq!(px(0, 0), [0, 0, 0], "row 0 is the top row");
+    assert_eq!(px(1, 0), [255, 255, 255]);
+    assert_eq!(px(2, 0), [188, 188, 188]);
+    assert_eq!(px(3, 0), [10, 10, 10], "12.92 * 0.0031308 * 255 = 10.3");
+    assert_eq!(px(0, 1), [10, 10, 10], "continuous across the linear/power boundary");
+    assert_eq!(px(1, 1), [srgb8_exact(0.2), srgb8_exact(0.04), srgb8_exact(0.8)]);
+    assert_eq!(px(2, 1), [0, 255, 0], "NaN -> 0, +inf -> 255, negative -> 0");
+    assert_eq!(px(3, 1), [0, 0, 0]);
+    assert_eq!(dir.entries(), ["out.png"]);
+}
+
+#[test]
+fn png_gkit_linear_truncates_without_gamma() {
+    let dir = TempDir::new("png-gkit");
+    let path = dir.path("gkit.PNG");
+    let pixels = [g(0.5), g(0.999), g(1.0), g(2.0), Vec3::new(f32::NAN, f32::INFINITY, -0.5)];
+    write_image(&path, 5, 1, &pixels, PngEncoding::GkitLinear).expect("write png");
+
+    let bytes = fs::read(&path).expect("read png");
+    let img = image::load_from_memory(&bytes).expect("decode png").to_rgb8();
+    let row: Vec<[u8; 3]> = img.pixels().map(|p| p.0).collect();
+    assert_eq!(row, [[127; 3], [254; 3], [255; 3], [255; 3], [0, 255, 0]]);
+}
+
+#[test]
+fn exr_round_trip_is_bit_exact_and_top_down() {
+    let dir = TempDir::new("exr");
+    let path = dir.path("out.Exr");
+    let (w, h) = (3usize, 2usize);
+    let pixels = [
+        Vec3::new(0.0, 1.0, 0.5),
+        Vec3::new(1e-42, -3.25, 1e30),
+        Vec3::new(f32::INFINITY, f32::NEG_INFINITY, f32::NAN),
+        Vec3::new(0.1, 0.2, 0.3),
+        Vec3::new(-0.0, 65504.5, 1.0 / 3.0),
+        Vec3::new(7.0, 8.0, 9.0),
+    ];
+    write_image(&path, w as u32, h as u32, &pixels, PngEncoding::default()).expect("write exr");
+
+    let image = exr::prelude::read_first_rgba_layer_from_file(
+        &path,
+        |size, _| vec![[0.0f32; 3]; size.width() * size.height()],
+        move |out: &mut Vec<[f32; 3]>, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+            out[pos.y() * w + pos.x()] = [r, g, b];
+        },
+    )
+    .expect("read exr");
+    let size = image.layer_data.size;
+    assert_eq!((size.width(), size.height()), (w, h));
+    let read = &image.layer_data.channel_data.pixels;
+    for (i, (got, want)) in read.iter().zip(&pixels).enumerate() {
+        let got_bits = got.map(f32::to_bits);
+        let want_bits = want.to_array().map(f32::to_bits);
+        assert_eq!(got_bits, want_bits, "pixel {i} (row {}, from the top)", i / w);
+    }
+    assert_eq!(dir.entries(), ["out.Exr"]);
+}
+
+#[test]
+fn pfm_round_trip_rows_bottom_to_top() {
+    let dir = TempDir::new("pfm");
+    let path = dir.path("out.pfm");
+    let (w, h) = (2usize, 3usize);
+    let pixels: Vec<Vec3> = (0..w * h).map(|i| Vec3::new(i as f32, -(i as f32) * 0.5, 1e-3 * i as f32)).collect();
+    let mut with_specials = pixels.clone();
+    with_specials[1] = Vec3::new(f32::NAN, f32::INFINITY, f32::NEG_INFINITY);
+    write_image(&path, w as u32, h as u32, &with_specials, PngEncoding::Srgb).expect("write pfm");
+
+    let bytes = fs::read(&path).expect("read pfm");
+    let header = format!("PF\n{w} {h}\n-1.0\n");
+    assert!(bytes.starts_with(header.as_bytes()), "header");
+    let data = &bytes[header.len()..];
+    assert_eq!(data.len(), w * h * 3 * 4);
+    let floats: Vec<f32> = data.chunks_exact(4).map(|b| f32::from_le_bytes(b.try_into().expect("4 bytes"))).collect();
+    for (file_row, row) in floats.chunks_exact(w * 3).enumerate() {
+        let picture_row = h - 1 - file_row;
+        let expected = &with_specials[picture_row * w..(picture_row + 1) * w];
+        let got: Vec<u32> = row.iter().map(|f| f.to_bits()).collect();
+        let want: Vec<u32> = expected.iter().flat_map(|p| p.to_array()).map(f32::to_bits).collect();
+        assert_eq!(got, want, "file row {file_row} holds picture row {picture_row}");
+    }
+}
+
+#[test]
+fn unknown_or_missing_extension_is_invalid_and_writes_nothing() {
+    let dir = TempDir::new("ext");
+    for name in ["out.jpg", "out", "out.png.bak"] {
+        let path = dir.path(name);
+        let result = write_image(&path, 1, 1, &[g(0.5)], PngEncoding::Srgb);
+        assert_invalid(result, ".png, .exr, .pfm");
+        assert_invalid(check_output_path(&path), ".png, .exr, .pfm");
+    }
+    assert!(dir.entries().is_empty());
+}
+
+#[test]
+fn wrong_pixel_count_or_zero_size_is_invalid() {
+    let dir = TempDir::new("dims");
+    let path = dir.path("out.png");
+    assert_invalid(write_image(&path, 2, 2, &[g(0.0); 3], PngEncoding::Srgb), "3 pixels");
+    assert_invalid(write_image(&path, 0, 2, &[], PngEncoding::Srgb), "zero");
+    assert_invalid(write_image(&path, 2, 0, &[], PngEncoding::Srgb), "zero");
+    assert!(dir.entries().is_empty());
+}
+
+#[test]
+fn missing_directory_is_an_io_error_naming_the_path_and_leaves_nothing() {
+    let dir = TempDir::new("missing");
+    let path = dir.path("no/such/dir/out.exr");
+    assert_io_error(write_image(&path, 1, 1, &[g(1.0)], PngEncoding::Srgb), &path);
+    assert_io_error(write_atomically(&path, b"bytes"), &path);
+    assert_io_error(check_output_path(&path), &path);
+    assert!(dir.entries().is_empty());
+}
+
+#[test]
+fn overwrite_replaces_old_content_fully() {
+    let dir = TempDir::new("overwrite");
+    let path = dir.path("stats.json");
+    write_atomically(&path, &vec![b'x'; 100_000]).expect("first write");
+    write_atomically(&path, b"{}").expect("second write");
+    assert_eq!(fs::read(&path).expect("read back"), b"{}");
+
+    let image = dir.path("img.pfm");
+    fs::write(&image, vec![0u8; 10_000]).expect("old image");
+    write_image(&image, 1, 1, &[g(2.0)], PngEncoding::Srgb).expect("overwrite image");
+    let mut expected = b"PF\n1 1\n-1.0\n".to_vec();
+    expected.extend([2.0f32; 3].iter().flat_map(|f| f.to_le_bytes()));
+    assert_eq!(fs::read(&image).expect("read back"), expected);
+    assert_eq!(dir.entries(), ["img.pfm", "stats.json"]);
+}
+
+#[test]
+fn failed_rename_removes_the_temp_file_and_keeps_the_target() {
+    let dir = TempDir::new("rename-fails");
+    // A non-empty directory cannot be replaced by a file: the write succeeds, the rename fails.
+    let target = dir.path("taken.png");
+    fs::create_dir(&target).expect("dir in the way");
+    fs::write(target.join("keep"), b"keep").expect("content");
+    assert_io_error(write_image(&target, 1, 1, &[g(0.5)], PngEncoding::Srgb), &target);
+    assert_eq!(dir.entries(), ["taken.png"]);
+    assert_eq!(fs::read(target.join("keep")).expect("untouched"), b"keep");
+    assert_invalid(check_output_path(&target), "directory");
+}
+
+#[test]
+fn concurrent_writers_never_collide_or_leave_temp_files() {
+    let dir = TempDir::new("threads");
+    let path = dir.path("shared.bin");
+    let contents: Vec<Vec<u8>> = (0..8u8).map(|i| vec![i; 50_000 + usize::from(i)]).collect();
+    std::thread::scope(|s| {
+        for bytes in &contents {
+            let path = &path;
+            s.spawn(move || {
+                for _ in 0..20 {
+                    write_atomically(path, bytes).expect("concurrent write");
+                }
+            });
+        }
+    });
+    let last = fs::read(&path).expect("read back");
+    assert!(contents.contains(&last), "the file is one writer's complete content");
+    assert_eq!(dir.entries(), ["shared.bin"]);
+}
+
+#[test]
+fn linear_to_srgb8_matches_exact_formula() {
+    // A dense uniform grid over [0, 1] ...
+    let n = 1 << 20;
+    for i in 0..=n {
+        let c = i as f32 / n as f32;
+        assert_eq!(linear_to_srgb8(c), srgb8_exact(c), "c = {c:e}");
+    }
+    // ... every f32 within 64 ulps of each rounding threshold, where a table would slip ...
+    for code in 1..=255u32 {
+        let v = (f64::from(code) - 0.5) / 255.0;
+        let lin = if v <= 0.04045 { v / 12.92 } else { ((v + 0.055) / 1.055).powf(2.4) };
+        let centre = (lin as f32).to_bits();
+        for bits in centre - 64..centre + 64 {
+            let x = f32::from_bits(bits);
+            assert_eq!(linear_to_srgb8(x), srgb8_exact(x), "c = {x:e} near code {code}");
+        }
+    }
+    // ... tiny values and out-of-range inputs.
+    for c in [f32::MIN_POSITIVE, 1e-45, 1e-10, 1e-5, 1.0f32.next_down()] {
+        assert_eq!(linear_to_srgb8(c), srgb8_exact(c), "c = {c:e}");
+    }
+    assert_eq!(linear_to_srgb8(f32::NAN), 0);
+    assert_eq!(linear_to_srgb8(-f32::NAN), 0);
+    assert_eq!(linear_to_srgb8(-1.0), 0);
+    assert_eq!(linear_to_srgb8(f32::NEG_INFINITY), 0);
+    assert_eq!(linear_to_srgb8(1.5), 255);
+    assert_eq!(linear_to_srgb8(f32::INFINITY), 255);
+}
+
+#[test]
+fn check_output_path_accepts_writable_targets_and_leaves_nothing() {
+    let dir = TempDir::new("check");
+    for name in ["a.png", "b.EXR", "c.pfm"] {
+        check_output_path(&dir.path(name)).expect("writable path");
+    }
+    let existing = dir.path("existing.png");
+    fs::write(&existing, b"old").expect("existing file");
+    check_output_path(&existing).expect("existing file may be overwritten");
+    assert_eq!(fs::read(&existing).expect("untouched"), b"old");
+    assert_eq!(dir.entries(), ["existing.png"]);
+}
+
+#[cfg(unix)]
+#[test]
+fn check_output_path_rejects_a_read_only_directory() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = TempDir::new("read-only");
+    let sub = dir.path("ro");
+    fs::create_dir(&sub).expect("subdir");
+    fs::set_permissions(&sub, fs::Permissions::from_mode(0o555)).expect("chmod");
+    // Root ignores directory permissions; then there is nothing to test.
+    let probe = sub.join("probe");
+    let privileged = fs::write(&probe, b"").is_ok();
+    let _ = fs::remove_file(&probe);
+    let path = sub.join("out.png");
+    if !privileged {
+        assert_io_error(check_output_path(&path), &path);
+        assert_io_error(write_image(&path, 1, 1, &[g(0.5)], PngEncoding::Srgb), &path);
+    }
+    fs::set_permissions(&sub, fs::Permissions::from_mode(0o755)).expect("chmod back");
+    assert!(fs::read_dir(&sub).expect("read subdir").next().is_none());
+}

@@ -1,0 +1,11 @@
+//! The library's integration tests, linked as one binary (one link instead of eight).
+
+mod common;
+
+mod bvh;
+mod camera;
+mod estimators;
+mod image_io;
+mod obj_loading;
+mod sampling;
+mod triangle;

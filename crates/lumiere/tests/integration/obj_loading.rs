@@ -1,0 +1,408 @@
+//! OBJ/MTL loading: statement forms, fan order, materials and warnings, errors with line numbers,
+//! chunked parallel parsing against the single-chunk path, and the scenes shipped in `shared/`.
+
+use crate::common::TempDir;
+use flate2::Compression;
+use flate2::write::GzEncoder;
+use glam::{Vec2, Vec3};
+use lumiere::scene::mesh::NO_INDEX;
+use lumiere::scene::obj::{ObjScene, load_obj, parse_obj, parse_obj_with_chunk_size};
+use std::io::{self, Write};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+const NONE: [u32; 3] = [NO_INDEX; 3];
+
+/// In-memory MTL files for `parse_obj`, looked up by the name `mtllib` gives.
+fn mtl_files(files: &[(&str, &str)]) -> impl Fn(&str) -> io::Result<(Vec<u8>, PathBuf)> + use<> {
+    let files: Vec<(String, String)> = files.iter().map(|&(n, t)| (n.to_string(), t.to_string())).collect();
+    move |name| match files.iter().find(|(n, _)| n == name) {
+        Some((_, text)) => Ok((text.clone().into_bytes(), Path::new("mem").join(name))),
+        None => Err(io::Error::new(io::ErrorKind::NotFound, format!("no file {name}"))),
+    }
+}
+
+fn parse(text: &str) -> ObjScene {
+    parse_with(text, &[])
+}
+
+fn parse_with(text: &str, mtls: &[(&str, &str)]) -> ObjScene {
+    match parse_obj(text.as_bytes(), Path::new("test.obj"), &mtl_files(mtls)) {
+        Ok(scene) => scene,
+        Err(error) => panic!("unexpected error: {error}"),
+    }
+}
+
+/// The error message for `bytes`, which must fail to parse.
+fn parse_error(bytes: &[u8]) -> String {
+    match parse_obj(bytes, Path::new("test.obj"), &mtl_files(&[])) {
+        Ok(scene) => panic!("expected an error, got {} triangles", scene.mesh.triangle_count()),
+        Err(error) => error.to_string(),
+    }
+}
+
+fn assert_error(bytes: &[u8], line: usize, needle: &str) {
+    let message = parse_error(bytes);
+    assert!(message.starts_with(&format!("test.obj:{line}: ")), "wrong line in {message:?}, expected {line}");
+    assert!(message.contains(needle), "{message:?} does not mention {needle:?}");
+}
+
+const SQUARE: &str = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n";
+
+/// Loads a scene of `../shared/scenes`; `None` (the test is skipped) when this clone has none.
+fn load_shared(relative: &str) -> Option<ObjScene> {
+    let path = crate::common::shared_scene(relative)?;
+    let start = Instant::now();
+    let scene = load_obj(&path).unwrap_or_else(|error| panic!("{error}"));
+    println!("{}: {} triangles in {:.3} s", path.display(), scene.mesh.triangle_count(), start.elapsed().as_secs_f64());
+    Some(scene)
+}
+
+fn material_of(scene: &ObjScene, triangle: usize) -> &lumiere::scene::material::Material {
+    &scene.materials[scene.mesh.material_ids[triangle] as usize]
+}
+
+#[test]
+fn negative_indices_are_relative_to_the_line() {
+    let scene = parse("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\nv 5 5 5\nf -4 -2 -1\n");
+    assert_eq!(scene.mesh.indices, vec![[0, 1, 2], [0, 2, 3]]);
+    assert_eq!(scene.mesh.positions[3], Vec3::splat(5.0));
+}
+
+#[test]
+fn crlf_tabs_trailing_spaces_and_no_final_newline() {
+    let scene = parse("v\t0 0 0 \r\nv 1\t0 0\r\n\r\n  v 0 1 0\t\r\n# comment\r\nf\t1 2  3 \r\nf 1 2 3");
+    assert_eq!(scene.mesh.indices, vec![[0, 1, 2], [0, 1, 2]]);
+    assert_eq!(scene.mesh.positions[1], Vec3::X);
+}
+
+#[test]
+fn polygons_split_as_fans_in_file_order() {
+    let text = format!("{SQUARE}v 2 2 0\nf 1 2 3 4\nf 5 4 3 2 1\n");
+    let scene = parse(&text);
+    let expected = vec![[0, 1, 2], [0, 2, 3], [4, 3, 2], [4, 2, 1], [4, 1, 0]];
+    assert_eq!(scene.mesh.indices, expected);
+}
+
+#[test]
+fn corner_forms_and_missing_attributes() {
+    let text = format!(
+        "{SQUARE}vt 0 0\nvt 1 0\nvt 1 1\nvn 0 0 1\nf 1//1 2//1 3//1\nf 1/1/1 2/2/1 3/3/1\nf 1/1 3/3 4/2\nf 1 2 3\n"
+    );
+    let scene = parse(&text);
+    assert_eq!(scene.mesh.normal_indices, vec![[0; 3], [0; 3], NONE, NONE]);
+    assert_eq!(scene.mesh.texcoord_indices, vec![NONE, [0, 1, 2], [0, 2, 1], NONE]);
+    assert_eq!(scene.mesh.texcoords[2], Vec2::ONE);
+    assert_eq!(scene.mesh.normals, vec![Vec3::Z]);
+}
+
+#[test]
+fn vertices_with_w_colours_and_short_texcoords() {
+    let scene = parse("v 0 0 0 1\nv 1 0 0 0.5 0.5 0.5\nv 0 1 0\nvt 0.25\nf 1/1 2/1 3/1\n");
+    assert_eq!(scene.mesh.positions[1], Vec3::X);
+    assert_eq!(scene.mesh.texcoords, vec![Vec2::new(0.25, 0.0)]);
+}
+
+#[test]
+fn attribute_lists_are_empty_without_attributes() {
+    let scene = parse(&format!("{SQUARE}vn 0 0 1\nvt 0 0\nf 1 2 3 4\n"));
+    assert_eq!(scene.mesh.triangle_count(), 2);
+    assert!(scene.mesh.normal_indices.is_empty() && scene.mesh.texcoord_indices.is_empty());
+}
+
+#[test]
+fn ignored_statements_and_empty_file() {
+    let text = format!("o thing\ng a b\ns off\n{SQUARE}l 1 2\np 3\nvp 0.5\ncurv 0 1 1 2\nf 1 2 3\n");
+    assert_eq!(parse(&text).mesh.triangle_count(), 1);
+    let empty = parse("");
+    assert_eq!(empty.mesh.triangle_count(), 0);
+    assert!(empty.materials.is_empty() && empty.warnings.is_empty());
+}
+
+#[test]
+fn non_utf8_comments_and_names_are_tolerated() {
+    let mut bytes = b"# cr\xe9\xe9 par un logiciel\n".to_vec();
+    bytes.extend_from_slice(SQUARE.as_bytes());
+    bytes.extend_from_slice(b"usemtl mat\xff\nf 1 2 3\n");
+    let scene = parse_obj(&bytes, Path::new("test.obj"), &mtl_files(&[])).expect("lenient parse");
+    assert_eq!(scene.materials[0].name, "mat\u{fffd}");
+}
+
+#[test]
+fn faces_before_usemtl_get_the_default_material_only_when_they_exist() {
+    let mtl = "newmtl red\nKd 1 0 0\nnewmtl blue\nKd 0 0 1\n";
+    let with_default = parse_with(&format!("mtllib m.mtl\n{SQUARE}f 1 2 3\nusemtl blue\nf 1 3 4\n"), &[("m.mtl", mtl)]);
+    let names: Vec<&str> = with_default.materials.iter().map(|m| m.name.as_str()).collect();
+    assert_eq!(names, ["red", "blue", "default"]);
+    assert_eq!(with_default.mesh.material_ids, vec![2, 1]);
+    assert_eq!(with_default.materials[2], lumiere::scene::material::Material::default_grey("default"));
+    assert!(with_default.warnings.is_empty(), "{:?}", with_default.warnings);
+
+    let without = parse_with(&format!("mtllib m.mtl\n{SQUARE}usemtl red\nf 1 2 3\n"), &[("m.mtl", mtl)]);
+    assert_eq!(without.materials.len(), 2);
+    assert_eq!(without.mesh.material_ids, vec![0]);
+}
+
+#[test]
+fn usemtl_of_an_undefined_name_gives_grey_and_one_warning() {
+    let scene = parse(&format!("{SQUARE}usemtl ghost\nf 1 2 3\nusemtl other\nf 1 2 3\nusemtl ghost\nf 1 3 4\n"));
+    assert_eq!(scene.mesh.material_ids, vec![0, 1, 0]);
+    assert_eq!(scene.materials[0].name, "ghost");
+    assert_eq!(scene.materials[0].kd, Vec3::splat(0.8));
+    assert_eq!(scene.warnings.len(), 2, "{:?}", scene.warnings);
+    assert!(scene.warnings[0].starts_with("test.obj:5:") && scene.warnings[0].contains("ghost"));
+}
+
+#[test]
+fn missing_mtl_warns_and_uses_grey() {
+    let dir = TempDir::new("missing-mtl");
+    let obj = dir.write("scene.obj", format!("mtllib nowhere.mtl\n{SQUARE}usemtl red\nf 1 2 3\n").as_bytes());
+    let scene = load_obj(&obj).expect("load");
+    assert_eq!(scene.materials.len(), 1);
+    assert_eq!(scene.materials[0], lumiere::scene::material::Material::default_grey("red"));
+    assert!(
+        scene.warnings.iter().any(|w| w.contains("nowhere.mtl") && w.contains("scene.obj:1:")),
+        "{:?}",
+        scene.warnings
+    );
+}
+
+#[test]
+fn broken_mtl_lines_warn_and_the_rest_is_kept() {
+    let mtl = "Kd 1 1 1\nnewmtl a\nKd 0.5 zero 0.5\nKs 0.1\nNs 12 13\nillum x\nnewmtl b\nKe inf 0 0\nKd 0 1 0\n";
+    let scene = parse_with(&format!("mtllib bad.mtl\n{SQUARE}usemtl b\nf 1 2 3\n"), &[("bad.mtl", mtl)]);
+    let lines: Vec<&str> = scene.warnings.iter().map(|w| w.split(": ").next().unwrap_or("")).collect();
+    assert_eq!(
+        lines,
+        ["mem/bad.mtl:1", "mem/bad.mtl:3", "mem/bad.mtl:5", "mem/bad.mtl:6", "mem/bad.mtl:8"],
+        "{:?}",
+        scene.warnings
+    );
+    assert!(scene.warnings[1].contains("\"zero\""));
+    assert_eq!(scene.materials[0].ks, Vec3::splat(0.1));
+    assert_eq!(scene.materials[0].kd, Vec3::splat(0.8));
+    assert_eq!(material_of(&scene, 0).kd, Vec3::Y);
+    assert_eq!(material_of(&scene, 0).ke, Vec3::ZERO);
+}
+
+#[test]
+fn mtl_statements_and_texture_paths() {
+    let dir = TempDir::new("mtl-statements");
+    std::fs::create_dir_all(dir.0.join("materials")).expect("mkdir");
+    let mtl = "newmtl glass  # comment\n  Kd 0.1 0.2 0.3\n\tKs 0.5\nKe 1 2 3\nNs 50\nNi 1.5\nTr 0.25\nillum 7\n\
+               map_Kd -bm 1 -o 0 0 0 tex\\wood.png\nmap_Bump bump.png\nKa 1 1 1\nnewmtl ghostly\nd -halo 0.5\n";
+    dir.write("materials/glass.mtl", mtl.as_bytes());
+    let obj = dir.write("scene.obj", format!("mtllib materials/glass.mtl\n{SQUARE}usemtl glass\nf 1 2 3\n").as_bytes());
+    let scene = load_obj(&obj).expect("load");
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    let glass = &scene.materials[0];
+    assert_eq!(glass.name, "glass");
+    assert_eq!((glass.kd, glass.ks, glass.ke), (Vec3::new(0.1, 0.2, 0.3), Vec3::splat(0.5), Vec3::new(1.0, 2.0, 3.0)));
+    assert_eq!((glass.ns, glass.ni, glass.dissolve, glass.illum), (50.0, 1.5, 0.75, 7));
+    assert_eq!(glass.map_kd.as_deref(), Some(dir.0.join("materials/tex/wood.png").as_path()));
+    assert!(scene.materials[1].map_kd.is_none());
+    assert_eq!(scene.materials[1].dissolve, 0.5);
+}
+
+#[test]
+fn mtllib_with_several_files_or_a_name_with_spaces() {
+    let a = "newmtl a\nKd 1 0 0\n";
+    let b = "newmtl b\nKd 0 1 0\n";
+    let several =
+        parse_with(&format!("mtllib a.mtl b.mtl\n{SQUARE}usemtl b\nf 1 2 3\n"), &[("a.mtl", a), ("b.mtl", b)]);
+    assert_eq!(several.materials.len(), 2);
+    assert_eq!(material_of(&several, 0).kd, Vec3::Y);
+    let spaced =
+        parse_with(&format!("mtllib my materials.mtl\n{SQUARE}usemtl a\nf 1 2 3\n"), &[("my materials.mtl", a)]);
+    assert!(spaced.warnings.is_empty(), "{:?}", spaced.warnings);
+    assert_eq!(material_of(&spaced, 0).kd, Vec3::X);
+}
+
+#[test]
+fn gzipped_obj_loads_and_corrupt_gzip_fails() {
+    let dir = TempDir::new("gz");
+    let mut encoder = GzEncoder::new(Vec::new(), Compression::default());
+    encoder.write_all(format!("mtllib m.mtl\n{SQUARE}usemtl red\nf 1 2 3 4\n").as_bytes()).expect("gzip");
+    let gz = encoder.finish().expect("gzip");
+    dir.write("m.mtl", b"newmtl red\nKd 1 0 0\n");
+    let scene = load_obj(&dir.write("scene.obj.gz", &gz)).expect("load gz");
+    assert_eq!(scene.mesh.indices, vec![[0, 1, 2], [0, 2, 3]]);
+    assert_eq!(material_of(&scene, 1).kd, Vec3::X);
+
+    let corrupt = dir.write("corrupt.obj.gz", &gz[..gz.len() / 2]);
+    assert!(load_obj(&corrupt).is_err());
+    assert!(load_obj(&dir.write("plain.obj.gz", b"v 0 0 0\n")).is_err());
+    assert!(matches!(load_obj(&dir.0.join("absent.obj")), Err(lumiere::Error::Io { .. })));
+}
+
+#[test]
+fn malformed_numbers_are_named() {
+    assert_error(b"v 0 0 0\nv 1 x 0\n", 2, "\"x\"");
+    assert_error(b"v 0 0\n", 1, "at least 3");
+    assert_error(b"vn 0 0 1.0.0\n", 1, "\"1.0.0\"");
+    assert_error(b"vt \xff\xfe 0\n", 1, "malformed number");
+}
+
+#[test]
+fn non_finite_coordinates_are_refused() {
+    assert_error(b"\nv nan 0 0\n", 2, "\"nan\"");
+    assert_error(b"v 0 inf 0\n", 1, "not finite");
+    assert_error(b"v 0 0 1e39\n", 1, "not finite");
+    assert_error(b"vn 0 0 -infinity\n", 1, "not finite");
+}
+
+#[test]
+fn faces_need_three_valid_corners() {
+    let square = SQUARE.as_bytes();
+    let with = |face: &str| [square, face.as_bytes()].concat();
+    assert_error(&with("f 1 2\n"), 5, "2 corner");
+    assert_error(&with("f\n"), 5, "0 corner");
+    assert_error(&with("f 1 0 2\n"), 5, "index 0");
+    assert_error(&with("f 1 2 5\n"), 5, "position index 5 out of range");
+    assert_error(&with("f 1 2 -5\n"), 5, "position index -5 out of range");
+    assert_error(&with("f 1 2 3/1\n"), 5, "texture coordinate index 1 out of range");
+    assert_error(&with("f 1 2 3//-1\n"), 5, "normal index -1 out of range");
+    assert_error(&with("f 1/2/3/4 2 3\n"), 5, "\"1/2/3/4\"");
+    assert_error(&with("f a/b 2 3\n"), 5, "\"a/b\"");
+    assert_error(&with("f 1/ 2 3\n"), 5, "malformed face corner");
+    assert_error(&with("f 1// 2 3\n"), 5, "malformed face corner");
+    assert_error(&with("f /1 2 3\n"), 5, "malformed face corner");
+    assert_error(&with("f 1 2 3 --4\n"), 5, "malformed face corner");
+    assert_error(&with("usemtl\n"), 5, "usemtl");
+}
+
+#[test]
+fn huge_indices_do_not_overflow() {
+    for index in [
+        "9223372036854775807",
+        "-9223372036854775808",
+        "99999999999999999999999",
+        "-99999999999999999999",
+        "4294967296",
+        "-4294967295",
+    ] {
+        let text = format!("{SQUARE}f 1 2 {index}\n");
+        assert_error(text.as_bytes(), 5, &format!("index {index} out of range"));
+        let text = format!("{SQUARE}vn 0 0 1\nf 1 2 3//{index}\n");
+        assert_error(text.as_bytes(), 6, "normal index");
+    }
+}
+
+/// A file with `lines` vertices and faces interleaved, negative indices reaching back across
+/// many lines, `usemtl` switches, mixed corner forms, comments and CRLF lines.
+fn generated_obj(faces: usize) -> String {
+    let mut text = String::from("mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvt 0 0\n");
+    for i in 0..faces {
+        let x = i as f32 * 0.5;
+        text += &format!("v {x} 1 2\r\nv {x} 3 4\nvt {x} 0.5\n");
+        if i % 7 == 0 {
+            text += &format!("usemtl {}\n", ["red", "blue", "ghost"][i % 3]);
+        }
+        match i % 4 {
+            0 => text += "f -1 -2 -3\n",
+            1 => text += &format!("f {} -1/-1 -5/-2 -7//1\n", 2 * i + 1),
+            2 => text += "# a comment line\nf -4/1/1 -3/2/-1 -2/-1 -1\n",
+            _ => text += &format!("\tf -2//-1 -3//1 {}//1 -6 -7\n", i + 3),
+        }
+    }
+    text
+}
+
+#[test]
+fn chunked_parsing_matches_a_single_chunk() {
+    let text = generated_obj(3000);
+    let mtl = "newmtl red\nKd 1 0 0\nnewmtl blue\nKd 0 0 1\n";
+    let read = mtl_files(&[("m.mtl", mtl)]);
+    let name = Path::new("gen.obj");
+    let single = parse_obj_with_chunk_size(text.as_bytes(), name, &read, usize::MAX).expect("single chunk");
+    assert!(single.mesh.triangle_count() > 5000);
+    for chunk in [1, 17, 100, 4096] {
+        let chunked = parse_obj_with_chunk_size(text.as_bytes(), name, &read, chunk).expect("chunked");
+        let (a, b) = (&single.mesh, &chunked.mesh);
+        assert_eq!(a.indices, b.indices, "chunk {chunk}");
+        assert_eq!(a.positions, b.positions);
+        assert_eq!(a.normals, b.normals);
+        assert_eq!(a.texcoords, b.texcoords);
+        assert_eq!(a.normal_indices, b.normal_indices);
+        assert_eq!(a.texcoord_indices, b.texcoord_indices);
+        assert_eq!(a.material_ids, b.material_ids);
+        assert_eq!(single.materials, chunked.materials);
+        assert_eq!(single.warnings, chunked.warnings);
+    }
+    assert_eq!(single.materials.len(), 3);
+    assert_eq!(single.warnings.len(), 1, "{:?}", single.warnings);
+}
+
+#[test]
+fn chunked_errors_report_the_first_bad_line() {
+    let mut text = generated_obj(2000);
+    let bad_line = text.lines().count() + 1;
+    text += "f 1 2 -999999\nv 0 0 nan\n";
+    let read = mtl_files(&[]);
+    for chunk in [1, 100, usize::MAX] {
+        let error =
+            parse_obj_with_chunk_size(text.as_bytes(), Path::new("gen.obj"), &read, chunk).expect_err("must fail");
+        assert!(error.to_string().starts_with(&format!("gen.obj:{bad_line}: ")), "{error}");
+    }
+}
+
+#[test]
+fn gkit_cornell_box() {
+    let Some(scene) = load_shared("cornell/cornell.obj") else { return };
+    assert_eq!(scene.mesh.triangle_count(), 32);
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    let emissive: Vec<usize> = (0..32).filter(|&t| material_of(&scene, t).is_emissive()).collect();
+    assert_eq!(emissive, [12, 13]);
+    assert_eq!(material_of(&scene, 12).name, "light.001");
+    assert_eq!(material_of(&scene, 12).ke, Vec3::splat(100.0));
+    let left = scene.materials.iter().find(|m| m.name == "leftWall.001").expect("leftWall.001");
+    assert_eq!(left.kd, Vec3::new(0.63, 0.065, 0.05));
+}
+
+#[test]
+fn mcguire_cornell_box() {
+    let Some(scene) = load_shared("cornell-mcguire/CornellBox-Original.obj") else { return };
+    assert_eq!(scene.mesh.triangle_count(), 36);
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    let emissive: Vec<usize> = (0..36).filter(|&t| material_of(&scene, t).is_emissive()).collect();
+    assert_eq!(emissive, [34, 35]);
+    assert_eq!(material_of(&scene, 34).name, "light");
+    assert_eq!(material_of(&scene, 34).ke, Vec3::new(17.0, 12.0, 4.0));
+}
+
+#[test]
+fn stanford_bunny() {
+    let Some(scene) = load_shared("bunny/stanford-bunny.obj") else { return };
+    assert_eq!(scene.mesh.triangle_count(), 69_451);
+    assert_eq!(scene.materials, [lumiere::scene::material::Material::default_grey("default")]);
+    assert!(scene.mesh.material_ids.iter().all(|&id| id == 0));
+    assert!(scene.warnings.is_empty());
+}
+
+#[test]
+fn staircase_with_textures() {
+    let Some(scene) = load_shared("staircase/staircase.obj.gz") else { return };
+    assert_eq!(scene.mesh.triangle_count(), 262_663);
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    assert_eq!(scene.materials.len(), 25);
+    let textured: Vec<&Path> = scene.materials.iter().filter_map(|m| m.map_kd.as_deref()).collect();
+    assert!(!textured.is_empty());
+    assert!(textured.iter().all(|path| path.exists()), "{textured:?}");
+    let lights: Vec<&str> = scene.materials.iter().filter(|m| m.is_emissive()).map(|m| m.name.as_str()).collect();
+    assert_eq!(lights, ["AreaLight"]);
+}
+
+#[test]
+fn bunny_1m_loads_fast() {
+    let Some(scene) = load_shared("bunny-1m/stanford-bunny-1m.obj.gz") else { return };
+    assert_eq!(scene.mesh.triangle_count(), 1_111_216);
+    assert_eq!(scene.mesh.positions.len(), 557_164);
+    assert!(scene.mesh.normal_indices.is_empty() && scene.mesh.texcoord_indices.is_empty());
+}
+
+#[test]
+fn a_utf8_byte_order_mark_is_skipped() {
+    let no_mtl = |_: &str| Err(io::Error::new(io::ErrorKind::NotFound, "none"));
+    let scene = parse_obj(b"\xEF\xBB\xBFv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", Path::new("bom.obj"), &no_mtl).unwrap();
+    assert_eq!((scene.mesh.positions.len(), scene.mesh.triangle_count()), (3, 1));
+}
