@@ -11,14 +11,14 @@
 #![allow(dead_code)]
 
 use lumiere::Error;
-use lumiere::checkpoint::Checkpoint;
-use lumiere::fingerprint::StableHasher;
 use lumiere::integrators::Mode;
+use lumiere::render::checkpoint::Checkpoint;
 use lumiere::render::{RenderOptions, render};
 use lumiere::scene::Scene;
 use lumiere::scene::camera::{Camera, Orbiter};
 use lumiere::scene::mesh::NO_INDEX;
 use lumiere::scene::obj::{ObjScene, parse_obj, parse_obj_with_chunk_size};
+use lumiere::util::hash::StableHasher;
 use lumiere::world::World;
 use std::io;
 use std::path::{Path, PathBuf};

@@ -4,16 +4,15 @@
 //! a crash, a full disk or a killed process never leaves a half-written image where a previous good
 //! one used to be: readers see either the old file or the complete new one.
 
-use std::fs::{self, File, OpenOptions};
-use std::io::{Cursor, Write};
-use std::path::{Path, PathBuf};
+use std::io::Cursor;
+use std::path::Path;
 use std::sync::OnceLock;
-use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::Vec3;
 use image::{ExtendedColorType, ImageEncoder};
 
 use crate::error::{Error, Result};
+use crate::util::fs::{check_writable, write_atomically};
 
 /// How a PNG stores linear radiance.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -53,35 +52,11 @@ pub fn write_image(path: &Path, width: u32, height: u32, pixels: &[Vec3], png: P
     write_atomically(path, &bytes)
 }
 
-/// Writes arbitrary bytes atomically (same temp-then-rename rule); used by write_image and by other
-/// writers (stats JSON, checkpoints).
-pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
-    let temp = temp_path(path)?;
-    // Created separately so that a failure here (missing directory, no permission) leaves nothing to
-    // clean up, and so we never remove a file we did not create.
-    let file = create_new(&temp).map_err(|e| Error::io(path, e))?;
-    fill_and_rename(file, &temp, path, bytes).map_err(|e| {
-        // Best effort: the error worth reporting is the one that made us give up.
-        let _ = fs::remove_file(&temp);
-        Error::io(path, e)
-    })
-}
-
 /// Checks before a long render that `path` has a supported extension and its directory exists and is writable
 /// (create and delete a probe temp file), so a render does not run for minutes and then fail.
 pub fn check_output_path(path: &Path) -> Result<()> {
     format_of(path)?;
     check_writable(path)
-}
-
-/// Checks that a file can be created at `path` (any extension) without touching `path` itself.
-pub fn check_writable(path: &Path) -> Result<()> {
-    if path.is_dir() {
-        return Err(Error::invalid(format!("{}: is a directory, expected a file name", path.display())));
-    }
-    let probe = temp_path(path)?;
-    create_new(&probe).map_err(|e| Error::io(path, e))?;
-    fs::remove_file(&probe).map_err(|e| Error::io(&probe, e))
 }
 
 /// sRGB encoding of one linear channel to 8 bits (IEC 61966-2-1), clamped; NaN -> 0.
@@ -225,29 +200,4 @@ fn encode_pfm(width: u32, height: u32, pixels: &[Vec3]) -> Vec<u8> {
         }
     }
     bytes
-}
-
-/// `.{file_name}.tmp{pid}-{n}` next to `path`: the same directory keeps the final rename atomic (no
-/// cross-device copy), the pid separates processes and the counter separates threads of this one.
-fn temp_path(path: &Path) -> Result<PathBuf> {
-    static COUNTER: AtomicU64 = AtomicU64::new(0);
-    let name =
-        path.file_name().ok_or_else(|| Error::invalid(format!("{}: output path has no file name", path.display())))?;
-    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-    let temp_name = format!(".{}.tmp{}-{n}", name.to_string_lossy(), std::process::id());
-    Ok(path.with_file_name(temp_name))
-}
-
-/// `create_new` so that a stale file with the same name (a pid reused after a crash) is never clobbered.
-fn create_new(path: &Path) -> std::io::Result<File> {
-    OpenOptions::new().write(true).create_new(true).open(path)
-}
-
-/// Writes and fsyncs before renaming, so that the rename cannot publish a file whose data is still only
-/// in the page cache; the handle is closed before the rename, which Windows requires.
-fn fill_and_rename(mut file: File, temp: &Path, path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    file.write_all(bytes)?;
-    file.sync_all()?;
-    drop(file);
-    fs::rename(temp, path)
 }

@@ -21,10 +21,7 @@
 //! ```
 
 pub mod accel;
-pub mod checkpoint;
 pub mod error;
-pub mod film;
-pub mod fingerprint;
 pub mod geometry;
 pub mod image_io;
 pub mod integrators;
@@ -34,6 +31,7 @@ pub mod render;
 pub mod sampler;
 pub mod sampling;
 pub mod scene;
+pub mod util;
 pub mod world;
 
 pub use error::{Error, Result};

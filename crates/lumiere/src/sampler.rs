@@ -8,6 +8,8 @@
 
 use glam::Vec2;
 
+use crate::util::hash::mix64;
+
 /// Which sequence a [`Sampler`] draws from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 pub enum SamplerKind {
@@ -91,16 +93,6 @@ impl SobolSeeds {
         let h = mix64(mix64(seed ^ 0x50B0_15C4_A3B1_ED00) ^ (u64::from(pixel) << 32 | u64::from(dimension)));
         SobolSeeds { shuffle: h as u32, x: (h >> 32) as u32, y: mix64(h) as u32 }
     }
-}
-
-/// The murmur3 64-bit finaliser: every input bit affects every output bit with probability ~1/2.
-#[inline]
-fn mix64(mut h: u64) -> u64 {
-    h ^= h >> 33;
-    h = h.wrapping_mul(0xFF51_AFD7_ED55_8CCD);
-    h ^= h >> 33;
-    h = h.wrapping_mul(0xC4CE_B9FE_1A85_EC53);
-    h ^ (h >> 33)
 }
 
 /// The top 24 bits of `bits` as a float in `[0, 1)`; 24 bits are all an `f32` below 1 can hold

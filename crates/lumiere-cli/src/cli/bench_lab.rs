@@ -2,11 +2,11 @@
 //! lab's own figures.
 
 use crate::bench::bvh::median_seconds;
-use lumiere::image_io::write_atomically;
 use lumiere::integrators::Mode;
 use lumiere::render::{RenderOptions, render};
 use lumiere::scene::camera::Camera;
 use lumiere::scene::{Scene, builtin};
+use lumiere::util::fs::write_atomically;
 use lumiere::world::World;
 use lumiere::{Error, Result};
 

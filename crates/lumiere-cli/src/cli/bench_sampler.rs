@@ -3,7 +3,8 @@
 
 use lumiere::Result;
 use lumiere::integrators::Mode;
-use lumiere::render::{Image, RenderOptions, render};
+use lumiere::render::film::Image;
+use lumiere::render::{RenderOptions, render};
 use lumiere::sampler::SamplerKind;
 use lumiere::scene::camera::Camera;
 use lumiere::scene::{Scene, builtin};

@@ -8,8 +8,8 @@
 use std::path::Path;
 
 use crate::bench::rays::{Query, RaySet};
-use lumiere::image_io::write_atomically;
 use lumiere::scene::mesh::TriangleMesh;
+use lumiere::util::fs::write_atomically;
 use lumiere::world::World;
 use lumiere::{Error, Result};
 

@@ -5,15 +5,16 @@ use std::time::Instant;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use lumiere::accel::BuildPreset;
-use lumiere::checkpoint::Checkpoint;
-use lumiere::film::Film;
-use lumiere::fingerprint::{options_fingerprint, scene_fingerprint};
-use lumiere::image_io::{PngEncoding, check_output_path, check_writable, write_atomically, write_image};
+use lumiere::image_io::{PngEncoding, check_output_path, write_image};
 use lumiere::integrators::LightSampling;
+use lumiere::render::checkpoint::Checkpoint;
+use lumiere::render::film::Film;
+use lumiere::render::fingerprint::{options_fingerprint, scene_fingerprint};
 use lumiere::render::{Hooks, RenderOptions, RenderStats, StopReason, render_progressive};
 use lumiere::sampler::SamplerKind;
 use lumiere::scene::camera::{Camera, Orbiter};
 use lumiere::scene::{Scene, builtin};
+use lumiere::util::fs::{check_writable, write_atomically};
 use lumiere::world::World;
 use lumiere::{Error, Result};
 

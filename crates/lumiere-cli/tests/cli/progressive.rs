@@ -6,8 +6,8 @@ use std::process::{Child, Command, Output, Stdio};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-use lumiere::film::Film;
 use lumiere::integrators::Mode;
+use lumiere::render::film::Film;
 use lumiere::render::{Hooks, RenderOptions, RenderStats, StopReason, render, render_progressive};
 use lumiere::scene::camera::Camera;
 use lumiere::scene::{Scene, builtin};

@@ -16,10 +16,11 @@ mod text;
 use crate::error::{Error, Result};
 use crate::scene::material::Material;
 use crate::scene::mesh::{NO_INDEX, TriangleMesh};
+use crate::util::fs;
 use chunk::{ChunkCounts, ChunkMesh, ChunkStart, VertexCounts, parse_chunk};
 use materials::{MaterialTable, ReadMtl};
 use rayon::prelude::*;
-use std::io::{self, Read};
+use std::io;
 use std::path::Path;
 
 /// Chunk size for parallel parsing: large enough that per-chunk overhead is noise, small enough
@@ -37,11 +38,11 @@ pub struct ObjScene {
 
 /// Loads `path` (`.obj` or `.obj.gz`); `mtllib` files resolve relative to the OBJ's folder.
 pub fn load_obj(path: &Path) -> Result<ObjScene> {
-    let bytes = read_file(path).map_err(|error| Error::io(path, error))?;
+    let bytes = fs::read_input(path).map_err(|error| Error::io(path, error))?;
     let folder = path.parent().unwrap_or(Path::new(""));
     let read_mtl = |name: &str| {
         let mtl = folder.join(name);
-        match read_file(&mtl) {
+        match fs::read_input(&mtl) {
             Ok(bytes) => Ok((bytes, mtl)),
             // The OBJ only knows the name; the warning should say where we looked.
             Err(error) => Err(io::Error::new(error.kind(), format!("{}: {error}", mtl.display()))),
@@ -79,26 +80,6 @@ pub fn parse_obj_with_chunk_size(bytes: &[u8], name: &Path, read_mtl: ReadMtl, c
     let mut table = MaterialTable::load(libraries, name, read_mtl);
     let material_ids = material_ids(&parsed, &mut table, name);
     Ok(ObjScene { mesh: merge(&parsed, material_ids), materials: table.materials, warnings: table.warnings })
-}
-
-/// Reads a file, gunzipping it when its name ends with `.gz` (multi-member streams included).
-fn read_file(path: &Path) -> io::Result<Vec<u8>> {
-    let raw = std::fs::read(path)?;
-    if !path.extension().is_some_and(|extension| extension.eq_ignore_ascii_case("gz")) {
-        return Ok(raw);
-    }
-    // A few kilobytes of gzip can expand to gigabytes: stop at a quarter of the free memory, which
-    // leaves room for the mesh parsed from the text.
-    let limit = crate::film::available_memory().unwrap_or(16 << 30) / 4;
-    let mut bytes = Vec::new();
-    flate2::read::MultiGzDecoder::new(&raw[..]).take(limit + 1).read_to_end(&mut bytes)?;
-    if bytes.len() as u64 > limit {
-        return Err(io::Error::other(format!(
-            "decompresses to more than {:.1} GiB, over a quarter of the free memory; refusing it",
-            limit as f64 / (1u64 << 30) as f64
-        )));
-    }
-    Ok(bytes)
 }
 
 /// Cuts `bytes` into pieces of about `target` bytes, each ending just after a `\n` (but the last).

@@ -5,11 +5,18 @@
 use glam::Vec3;
 
 use crate::error::{Error, Result};
-use crate::render::Image;
 
 /// Bytes a pixel costs while rendering: the film (3 sums and a second moment in f64), the tile's
 /// pass buffer and the final image.
 pub const BYTES_PER_PIXEL: u64 = 4 * 8 + 4 * 8 + 3 * 4;
+
+/// Linear RGB pixels, row 0 at the top.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Image {
+    pub width: u32,
+    pub height: u32,
+    pub pixels: Vec<Vec3>,
+}
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Film {
@@ -96,7 +103,7 @@ impl Film {
 fn check_memory(width: u32, height: u32) -> Result<()> {
     // In u128: width * height * bytes overflows u64 for the largest u32 sizes.
     let needed = width as u128 * height as u128 * BYTES_PER_PIXEL as u128;
-    let available = available_memory().unwrap_or(64 << 30);
+    let available = crate::util::fs::available_memory().unwrap_or(64 << 30);
     if needed > available as u128 {
         return Err(Error::invalid(format!(
             "image size {width}x{height} needs {:.1} GiB of memory to render; {:.1} GiB is available",
@@ -105,22 +112,4 @@ fn check_memory(width: u32, height: u32) -> Result<()> {
         )));
     }
     Ok(())
-}
-
-/// Memory this process can still get: `MemAvailable` from /proc/meminfo, capped by the
-/// address-space limit (`ulimit -v`) from /proc/self/limits; `None` where neither is known.
-pub(crate) fn available_memory() -> Option<u64> {
-    let meminfo = std::fs::read_to_string("/proc/meminfo").ok().and_then(|info| {
-        let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
-        Some(line.split_whitespace().nth(1)?.parse::<u64>().ok()? * 1024)
-    });
-    let address_space = std::fs::read_to_string("/proc/self/limits").ok().and_then(|limits| {
-        let line = limits.lines().find(|l| l.starts_with("Max address space"))?;
-        // "Max address space  <soft> <hard> bytes"; "unlimited" does not parse and gives None.
-        line.split_whitespace().nth(3)?.parse::<u64>().ok()
-    });
-    match (meminfo, address_space) {
-        (Some(a), Some(b)) => Some(a.min(b)),
-        (a, b) => a.or(b),
-    }
 }

@@ -3,6 +3,10 @@
 //! index and the options, never on the thread that ran them, and passes are accumulated in order,
 //! so images are identical for any thread count and for any stopping point.
 
+pub mod checkpoint;
+pub mod film;
+pub mod fingerprint;
+
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
@@ -10,13 +14,13 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
-use crate::film::Film;
 use crate::integrators::{
     AmbientOcclusion, Direct, Hits, Integrator, LightSampling, Materials, Mode, SampleContext, Shadows, dims,
 };
 use crate::sampler::{Sampler, SamplerKind};
 use crate::scene::camera::Camera;
 use crate::world::World;
+use film::{Film, Image};
 
 /// Tiles are small enough to balance two cores and to notice an interruption within milliseconds,
 /// and large enough that scheduling costs nothing.
@@ -75,14 +79,6 @@ impl RenderOptions {
         }
         Ok(())
     }
-}
-
-/// Linear RGB pixels, row 0 at the top.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Image {
-    pub width: u32,
-    pub height: u32,
-    pub pixels: Vec<Vec3>,
 }
 
 /// Why a render stopped.

@@ -10,10 +10,10 @@ use std::path::Path;
 use std::time::Duration;
 
 use crate::error::{Error, Result};
-use crate::film::Film;
-use crate::fingerprint::StableHasher;
-use crate::image_io::write_atomically;
 use crate::render::RenderStats;
+use crate::render::film::Film;
+use crate::util::fs::write_atomically;
+use crate::util::hash::hash_bytes;
 
 const MAGIC: &[u8; 8] = b"LUMCKPT1";
 const VERSION: u32 = 1;
@@ -49,7 +49,7 @@ impl Checkpoint {
                 out.extend_from_slice(&v.to_le_bytes());
             }
         }
-        let hash = hash_of(&out);
+        let hash = hash_bytes(&out);
         out.extend_from_slice(&hash.to_le_bytes());
         out
     }
@@ -70,7 +70,7 @@ impl Checkpoint {
             return Err(bad("no checkpoint header"));
         }
         let (body, hash) = bytes.split_at(bytes.len() - 8);
-        if hash_of(body).to_le_bytes() != hash {
+        if hash_bytes(body).to_le_bytes() != hash {
             return Err(bad("truncated or corrupted: its checksum does not match"));
         }
         let mut reader = Reader { bytes: &body[8..] };
@@ -99,13 +99,6 @@ impl Checkpoint {
         let stats = RenderStats { rays, elapsed };
         Ok(Checkpoint { scene_fingerprint, options_fingerprint, seed, film, stats })
     }
-}
-
-fn hash_of(bytes: &[u8]) -> u64 {
-    use std::hash::Hasher;
-    let mut h = StableHasher::default();
-    h.write(bytes);
-    h.finish()
 }
 
 /// Reads fixed-size fields; the caller has checked the length, so reads never run out.
