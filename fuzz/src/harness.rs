@@ -11,13 +11,12 @@
 #![allow(dead_code)]
 
 use lumiere::Error;
-use lumiere::integrators::Mode;
+use lumiere::integrators::Technique;
 use lumiere::render::checkpoint::Checkpoint;
 use lumiere::render::{RenderOptions, render};
-use lumiere::scene::Scene;
 use lumiere::scene::camera::{Camera, Orbiter};
+use lumiere::scene::load::obj::{ObjScene, parse_obj, parse_obj_with_chunk_size};
 use lumiere::scene::mesh::NO_INDEX;
-use lumiere::scene::obj::{ObjScene, parse_obj, parse_obj_with_chunk_size};
 use lumiere::util::hash::StableHasher;
 use lumiere::world::World;
 use std::io;
@@ -125,7 +124,7 @@ pub fn scene_target(data: &[u8]) -> Result<(), String> {
     let result = parse_obj(obj, file, &mtl_resolver(mtl));
     check_obj(&result, file, obj)?;
     let Ok(obj) = result else { return Ok(()) };
-    let scene = Scene::from_obj(obj, OBJ_NAME.to_string()).map_err(|e| format!("consistent OBJ refused: {e}"))?;
+    let scene = obj.into_scene(OBJ_NAME.to_string()).map_err(|e| format!("consistent OBJ refused: {e}"))?;
     let bounds = scene.bounds();
     // The CLI's default framing (src/cli/render.rs), or a fixed view of an empty scene.
     let (eye, target) = if bounds.is_empty() {
@@ -138,8 +137,15 @@ pub fn scene_target(data: &[u8]) -> Result<(), String> {
     // Framing a scene with coordinates near f32::MAX can fail (eye == target); the CLI reports it.
     let Ok(camera) = Camera::look_at(eye, target, glam::Vec3::Y, 45.0, 8, 6) else { return Ok(()) };
     let world = World::new(scene, Default::default());
-    for mode in [Mode::Hits, Mode::Materials, Mode::Shadows, Mode::Direct, Mode::AmbientOcclusion] {
-        let output = render(&world, &camera, &RenderOptions::new(mode, 1), &|_| {})
+    let techniques = [
+        Technique::Hits(Default::default()),
+        Technique::Materials(Default::default()),
+        Technique::Shadows(Default::default()),
+        Technique::direct(1),
+        Technique::ambient_occlusion(1),
+    ];
+    for mode in techniques {
+        let output = render(&world, &camera, &RenderOptions::new(mode), &|_| {})
             .map_err(|e| format!("{mode:?}: valid options refused: {e}"))?;
         if output.image.pixels.len() != 8 * 6 {
             return Err(format!("{mode:?}: {} pixels for 8x6", output.image.pixels.len()));

@@ -30,7 +30,7 @@ fn traversal(c: &mut Criterion) {
 
     // 256 segments from a floor point to the light, as soft shadows trace them.
     let origin = Vec3::new(0.3, 1e-4, 0.2);
-    let light = &world.scene.lights[0];
+    let light = &world.lights().lights()[0];
     let rays: Vec<Ray> = (0..256)
         .map(|i| {
             let (u, v) = ((i % 16) as f32 / 16.0 + 0.03, (i / 16) as f32 / 16.0 + 0.03);
@@ -45,8 +45,8 @@ fn traversal(c: &mut Criterion) {
     });
     c.bench_function("256 shadow rays: shared-origin batch (incl. prepare)", |b| {
         b.iter(|| {
-            batch.prepare(&world.bvh, origin, &shaft);
-            black_box(rays.iter().filter(|r| batch.occluded(&world.bvh, r)).count())
+            batch.prepare(world.bvh(), origin, &shaft);
+            black_box(rays.iter().filter(|r| batch.occluded(world.bvh(), r)).count())
         })
     });
 }

@@ -78,6 +78,71 @@ impl Sampler {
     }
 }
 
+/// The random numbers of one camera sample, drawn dimension after dimension: each call to
+/// [`SampleStream::next_points`] (or `next_1d`/`next_2d`) takes the next dimension, so a path draws
+/// as many as it needs (pixel position first, then whatever each bounce asks for) and stays a pure
+/// function of (pixel, sample, seed): the same numbers for any thread count or tile order.
+#[derive(Clone, Copy, Debug)]
+pub struct SampleStream<'a> {
+    sampler: &'a Sampler,
+    pixel: u32,
+    sample: u32,
+    dimension: u32,
+}
+
+impl<'a> SampleStream<'a> {
+    /// The stream of camera sample `sample` (0-based) of pixel `pixel` (`y · width + x`).
+    pub fn new(sampler: &'a Sampler, pixel: u32, sample: u32) -> Self {
+        SampleStream { sampler, pixel, sample, dimension: 0 }
+    }
+
+    /// The next dimension as a set of `n` points for this camera sample, e.g. the N shadow rays of
+    /// one light. Consecutive camera samples own consecutive blocks of `n` indices, so a stratified
+    /// sampler stratifies across all the camera samples of a pixel, not just within one.
+    #[inline]
+    pub fn next_points(&mut self, n: u32) -> PointSet<'a> {
+        let dimension = self.dimension;
+        self.dimension += 1;
+        PointSet { sampler: self.sampler, pixel: self.pixel, dimension, first: self.sample.wrapping_mul(n) }
+    }
+
+    /// One number from the next dimension.
+    #[inline]
+    pub fn next_1d(&mut self) -> f32 {
+        self.next_points(1).get_1d(0)
+    }
+
+    /// One 2D point from the next dimension.
+    #[inline]
+    pub fn next_2d(&mut self) -> Vec2 {
+        self.next_points(1).get_2d(0)
+    }
+}
+
+/// `n` points of one dimension of one camera sample (see [`SampleStream::next_points`]); nothing is
+/// computed until a point is asked for.
+#[derive(Clone, Copy, Debug)]
+pub struct PointSet<'a> {
+    sampler: &'a Sampler,
+    pixel: u32,
+    dimension: u32,
+    first: u32,
+}
+
+impl PointSet<'_> {
+    /// Point `k` of the set, in `[0, 1)`.
+    #[inline]
+    pub fn get_1d(&self, k: u32) -> f32 {
+        self.sampler.get_1d(self.pixel, self.first.wrapping_add(k), self.dimension)
+    }
+
+    /// Point `k` of the set, in `[0, 1)²`.
+    #[inline]
+    pub fn get_2d(&self, k: u32) -> Vec2 {
+        self.sampler.get_2d(self.pixel, self.first.wrapping_add(k), self.dimension)
+    }
+}
+
 /// The three scrambling seeds of one (seed, pixel, dimension): one shuffles the sample order, one
 /// scrambles each axis. Different pixels and dimensions thus get independent randomisations of
 /// the same (0, 2)-sequence, which decorrelates them.

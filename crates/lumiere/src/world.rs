@@ -1,46 +1,74 @@
-//! A scene with its acceleration structure: what integrators trace against.
+//! A scene with everything derived from it once before rendering: the acceleration structure and
+//! the lights. Integrators see the scene only through a [`World`].
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
-use crate::accel::{BuildPreset, Bvh, Bvh4, Hit};
+use crate::accel::{BuildPreset, Bvh, Bvh4, Hit, OriginBatch, Region};
+use crate::geometry::surface::SurfacePoint;
+use crate::lights::LightSet;
+use crate::materials::Material;
 use crate::math::Ray;
 use crate::scene::Scene;
 use crate::scene::mesh::NO_INDEX;
 
 pub struct World {
-    pub scene: Scene,
+    scene: Scene,
     /// The 4-wide BVH; the binary tree it was collapsed from is dropped to save memory.
-    pub bvh: Bvh4,
-}
-
-/// What an integrator needs to know about a hit point.
-#[derive(Clone, Copy, Debug)]
-pub struct SurfacePoint {
-    /// Position, interpolated from the vertices (more accurate than `origin + t * dir`).
-    pub p: Vec3,
-    /// Unit geometric normal, turned towards the side the ray came from.
-    pub ng: Vec3,
-    /// Unit shading normal (interpolated vertex normals when the file has them, else `ng`), on `ng`'s side.
-    pub ns: Vec3,
-    pub triangle: u32,
+    bvh: Bvh4,
+    lights: LightSet,
 }
 
 impl World {
+    /// Builds the BVH over the scene's triangles and derives its lights.
     pub fn new(scene: Scene, preset: BuildPreset) -> World {
         let binary = Bvh::build(&scene.mesh.positions, &scene.mesh.indices, preset);
-        World { scene, bvh: Bvh4::from_binary(&binary) }
+        let lights = LightSet::new(&scene);
+        World { bvh: Bvh4::from_binary(&binary), scene, lights }
     }
 
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    pub fn bvh(&self) -> &Bvh4 {
+        &self.bvh
+    }
+
+    pub fn lights(&self) -> &LightSet {
+        &self.lights
+    }
+
+    /// The material of triangle `id`.
+    #[inline]
+    pub fn material(&self, id: u32) -> &Material {
+        self.scene.material(id)
+    }
+
+    /// The closest hit along `ray` within `[0, ray.tmax]`.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         self.bvh.intersect(ray)
     }
 
+    /// Whether anything lies along `ray` within `[0, ray.tmax]`.
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
         self.bvh.occluded(ray)
     }
 
+    /// Readies `batch` for many rays leaving `origin` inside `region` (see [`OriginBatch`]).
+    #[inline]
+    pub fn prepare_batch(&self, batch: &mut OriginBatch, origin: Vec3, region: &Region) {
+        batch.prepare(&self.bvh, origin, region);
+    }
+
+    /// [`World::occluded`] for a ray of a batch prepared with [`World::prepare_batch`].
+    #[inline]
+    pub fn occluded_in_batch(&self, batch: &OriginBatch, ray: &Ray) -> bool {
+        batch.occluded(&self.bvh, ray)
+    }
+
+    /// The surface point of `hit`, found along `ray`.
     pub fn surface(&self, ray: &Ray, hit: &Hit) -> SurfacePoint {
         let mesh = &self.scene.mesh;
         let id = hit.triangle as usize;
@@ -50,7 +78,8 @@ impl World {
         let geometric = (p1 - p0).cross(p2 - p0).normalize_or_zero();
         let ng = if geometric.dot(ray.dir) > 0.0 { -geometric } else { geometric };
         let ns = self.interpolated_normal(id, w, hit.u, hit.v).map_or(ng, |n| if n.dot(ng) < 0.0 { -n } else { n });
-        SurfacePoint { p, ng, ns, triangle: hit.triangle }
+        let uv = self.interpolated_texcoord(id, w, hit.u, hit.v);
+        SurfacePoint { p, ng, ns, uv, triangle: hit.triangle, material: mesh.material_ids[id] }
     }
 
     fn interpolated_normal(&self, id: usize, w: f32, u: f32, v: f32) -> Option<Vec3> {
@@ -61,5 +90,14 @@ impl World {
         }
         let n = w * mesh.normals[a as usize] + u * mesh.normals[b as usize] + v * mesh.normals[c as usize];
         n.try_normalize()
+    }
+
+    fn interpolated_texcoord(&self, id: usize, w: f32, u: f32, v: f32) -> Vec2 {
+        let mesh = &self.scene.mesh;
+        let Some(&[a, b, c]) = mesh.texcoord_indices.get(id) else { return Vec2::ZERO };
+        if a == NO_INDEX || b == NO_INDEX || c == NO_INDEX {
+            return Vec2::ZERO;
+        }
+        w * mesh.texcoords[a as usize] + u * mesh.texcoords[b as usize] + v * mesh.texcoords[c as usize]
     }
 }

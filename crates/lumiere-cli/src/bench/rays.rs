@@ -42,9 +42,9 @@ pub fn make_ray_sets(world: &World, camera: &Camera, seed: u64) -> Vec<RaySet> {
     let (width, height) = (camera.width, camera.height);
     let primary: Vec<Ray> =
         (0..width * height).map(|p| camera.ray((p % width) as f32 + 0.5, (p / width) as f32 + 0.5)).collect();
-    let bounds = world.scene.bounds();
+    let bounds = world.scene().bounds();
     let fixed_light = bounds.center() + Vec3::Y * bounds.extent().length();
-    let lights = &world.scene.lights;
+    let lights = world.lights().lights();
 
     // For every primary hit: a shadow ray and a diffuse ray leaving from the offset hit point.
     let secondary: Vec<(Ray, Ray)> = primary

@@ -3,8 +3,6 @@ use std::path::PathBuf;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use glam::Vec3;
 
-use lumiere::integrators::Mode;
-
 #[derive(Parser, Debug)]
 #[command(name = "lumiere", version, about = "A CPU Monte Carlo ray tracer", propagate_version = true)]
 pub struct Cli {
@@ -124,18 +122,6 @@ pub enum LightSamplingArg {
     Power,
 }
 
-impl From<ModeArg> for Mode {
-    fn from(m: ModeArg) -> Mode {
-        match m {
-            ModeArg::Hits => Mode::Hits,
-            ModeArg::Materials => Mode::Materials,
-            ModeArg::Shadows => Mode::Shadows,
-            ModeArg::Direct => Mode::Direct,
-            ModeArg::Ao => Mode::AmbientOcclusion,
-        }
-    }
-}
-
 #[derive(Args, Debug)]
 pub struct RenderArgs {
     /// Wavefront OBJ file (.obj or .obj.gz); the built-in gKit Cornell box when omitted.
@@ -147,7 +133,7 @@ pub struct RenderArgs {
 
     /// Samples per light triangle (direct), in total (direct with power light sampling) or per
     /// hemisphere (ao).
-    #[arg(long, default_value_t = 16)]
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..))]
     pub samples: u32,
 
     /// Camera samples per pixel; 1 is one ray through the pixel centre, more are jittered in the pixel.

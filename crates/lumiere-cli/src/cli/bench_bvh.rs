@@ -5,7 +5,7 @@ use std::time::Instant;
 use crate::bench::bvh::{build, median_seconds, mesh_bytes, mismatches, peak_rss_mib, trace, work_per_ray};
 use crate::bench::rays::make_ray_sets;
 use crate::bench::scenes::BenchScene;
-use lumiere::accel::BuildPreset;
+use lumiere::accel::{BuildPreset, Bvh};
 use lumiere::util::fs::write_atomically;
 use lumiere::world::World;
 use lumiere::{Error, Result};
@@ -38,34 +38,35 @@ pub fn run(args: &BenchBvhArgs) -> Result<()> {
         eprintln!("{}: {triangles} triangles loaded in {load_ms:.0} ms", bench.name);
 
         // Reference structures and ray sets, built once.
-        let (binary, wide) = build(&scene.mesh, BuildPreset::Default);
+        let binary = Bvh::build(&scene.mesh.positions, &scene.mesh.indices, BuildPreset::Default);
         let costs: Vec<String> =
             BuildPreset::ALL.iter().map(|&p| format!("{:.1}", build(&scene.mesh, p).0.sah_cost())).collect();
-        let world = World { scene, bvh: wide };
+        let world = World::new(scene, BuildPreset::Default);
         let sets = make_ray_sets(&world, &camera, args.seed);
-        let bytes = mesh + world.bvh.memory_bytes();
+        let bytes = mesh + world.bvh().memory_bytes();
         for &n in &threads {
             let pool = pool(n)?;
             let build_ms = 1e3
-                * pool
-                    .install(|| median_seconds(args.repeats, || drop(build(&world.scene.mesh, BuildPreset::Default))));
+                * pool.install(|| {
+                    median_seconds(args.repeats, || drop(build(&world.scene().mesh, BuildPreset::Default)))
+                });
             builds.push(format!(
                 "| {} | {} | {triangles} | {load_ms:.0} | {build_ms:.0} | {} / {} | {} | {:.1} | {:.0} |",
                 bench.name,
                 n,
                 binary.nodes().len(),
-                world.bvh.nodes().len(),
+                world.bvh().nodes().len(),
                 costs.join(" / "),
                 bytes as f64 / triangles as f64,
                 peak_rss_mib().unwrap_or(f64::NAN),
             ));
-            json.push(serde_json::json!({"scene": bench.name, "threads": n, "what": "build", "triangles": triangles, "load_ms": load_ms, "build_ms": build_ms, "binary_nodes": binary.nodes().len(), "wide_nodes": world.bvh.nodes().len(), "bytes_per_triangle": bytes as f64 / triangles as f64}));
+            json.push(serde_json::json!({"scene": bench.name, "threads": n, "what": "build", "triangles": triangles, "load_ms": load_ms, "build_ms": build_ms, "binary_nodes": binary.nodes().len(), "wide_nodes": world.bvh().nodes().len(), "bytes_per_triangle": bytes as f64 / triangles as f64}));
         }
         for set in &sets {
-            let wrong = mismatches(&binary, &world.bvh, set);
-            let (nodes, blocks) = work_per_ray(&world.bvh, set);
+            let wrong = mismatches(&binary, world.bvh(), set);
+            let (nodes, blocks) = work_per_ray(world.bvh(), set);
             for &n in &threads {
-                let seconds = pool(n)?.install(|| median_seconds(args.repeats, || trace(&world.bvh, set)));
+                let seconds = pool(n)?.install(|| median_seconds(args.repeats, || trace(world.bvh(), set)));
                 let mrays = set.rays.len() as f64 / seconds / 1e6;
                 traces.push(format!(
                     "| {} | {} {} | {} | {} | {:.1} | {mrays:.1} | {nodes:.1} | {blocks:.1} | {wrong} |",

@@ -2,7 +2,7 @@
 //! lab's own figures.
 
 use crate::bench::bvh::median_seconds;
-use lumiere::integrators::Mode;
+use lumiere::integrators::{AmbientOcclusion, Direct, LightSampling, Shadows, Technique};
 use lumiere::render::{RenderOptions, render};
 use lumiere::scene::camera::Camera;
 use lumiere::scene::{Scene, builtin};
@@ -16,53 +16,51 @@ use super::pool;
 /// One row of the lab's table: what was rendered and the lab's serial and parallel milliseconds.
 struct LabRow {
     label: &'static str,
-    mode: Mode,
-    samples: u32,
+    technique: Technique,
     lab_serial_ms: f64,
     lab_parallel_ms: f64,
 }
 
 const LAB_ROWS: [LabRow; 7] = [
-    LabRow { label: "hard shadows", mode: Mode::Shadows, samples: 1, lab_serial_ms: 545.0, lab_parallel_ms: 272.0 },
+    LabRow {
+        label: "hard shadows",
+        technique: Technique::Shadows(Shadows),
+        lab_serial_ms: 545.0,
+        lab_parallel_ms: 272.0,
+    },
     LabRow {
         label: "soft shadows N=16",
-        mode: Mode::Direct,
-        samples: 16,
+        technique: Technique::Direct(Direct { samples: 16, light_sampling: LightSampling::PerLight }),
         lab_serial_ms: 5902.0,
         lab_parallel_ms: 2891.0,
     },
     LabRow {
         label: "soft shadows N=64",
-        mode: Mode::Direct,
-        samples: 64,
+        technique: Technique::Direct(Direct { samples: 64, light_sampling: LightSampling::PerLight }),
         lab_serial_ms: 22697.0,
         lab_parallel_ms: 11506.0,
     },
     LabRow {
         label: "soft shadows N=256",
-        mode: Mode::Direct,
-        samples: 256,
+        technique: Technique::Direct(Direct { samples: 256, light_sampling: LightSampling::PerLight }),
         lab_serial_ms: 89203.0,
         lab_parallel_ms: 46847.0,
     },
     LabRow {
         label: "AO N=16",
-        mode: Mode::AmbientOcclusion,
-        samples: 16,
+        technique: Technique::AmbientOcclusion(AmbientOcclusion { samples: 16, distance: f32::INFINITY }),
         lab_serial_ms: 5295.0,
         lab_parallel_ms: 1817.0,
     },
     LabRow {
         label: "AO N=64",
-        mode: Mode::AmbientOcclusion,
-        samples: 64,
+        technique: Technique::AmbientOcclusion(AmbientOcclusion { samples: 64, distance: f32::INFINITY }),
         lab_serial_ms: 19188.0,
         lab_parallel_ms: 6954.0,
     },
     LabRow {
         label: "AO N=256",
-        mode: Mode::AmbientOcclusion,
-        samples: 256,
+        technique: Technique::AmbientOcclusion(AmbientOcclusion { samples: 256, distance: f32::INFINITY }),
         lab_serial_ms: 71066.0,
         lab_parallel_ms: 26914.0,
     },
@@ -83,7 +81,7 @@ pub fn run(args: &BenchLabArgs) -> Result<()> {
     println!("|---|---|---|---|---|---|---|---|---|");
     let mut json = Vec::new();
     for row in &LAB_ROWS {
-        let options = RenderOptions::new(row.mode, row.samples);
+        let options = RenderOptions::new(row.technique);
         let mut rays = 0;
         let mut time = |pool: &rayon::ThreadPool| -> Result<f64> {
             let mut failure = None;
@@ -107,7 +105,7 @@ pub fn run(args: &BenchLabArgs) -> Result<()> {
             row.lab_parallel_ms / parallel_ms
         );
         json.push(serde_json::json!({
-            "image": row.label, "mode": row.mode.name(), "samples": row.samples, "width": width, "height": height,
+            "image": row.label, "mode": row.technique.name(), "technique": format!("{:?}", row.technique), "width": width, "height": height,
             "repeats": repeats, "lab_serial_ms": row.lab_serial_ms, "serial_ms": serial_ms,
             "lab_parallel_ms": row.lab_parallel_ms, "parallel_ms": parallel_ms, "threads": all_cores,
             "rays": rays, "mrays_per_s": mrays,

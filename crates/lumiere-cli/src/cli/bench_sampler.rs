@@ -2,7 +2,7 @@
 //! lab's sample counts, on the built-in scene's soft-shadow and ambient-occlusion images.
 
 use lumiere::Result;
-use lumiere::integrators::Mode;
+use lumiere::integrators::Technique;
 use lumiere::render::film::Image;
 use lumiere::render::{RenderOptions, render};
 use lumiere::sampler::SamplerKind;
@@ -16,8 +16,8 @@ pub fn run(args: &BenchSamplerArgs) -> Result<()> {
     let (width, height) = args.size;
     let world = World::new(Scene::builtin()?, Default::default());
     let camera = Camera::from_orbiter(&builtin::cornell_orbiter()?, width, height);
-    let render_image = |mode, samples, sampler, seed| -> Result<Image> {
-        let options = RenderOptions { sampler, seed, ..RenderOptions::new(mode, samples) };
+    let render_image = |technique: fn(u32) -> Technique, samples, sampler, seed| -> Result<Image> {
+        let options = RenderOptions { sampler, seed, ..RenderOptions::new(technique(samples)) };
         Ok(render(&world, &camera, &options, &|_| {})?.image)
     };
     println!(
@@ -25,7 +25,9 @@ pub fn run(args: &BenchSamplerArgs) -> Result<()> {
         args.reference_samples
     );
     println!("|---|---|---|---|---|---|");
-    for (label, mode) in [("soft shadows", Mode::Direct), ("AO", Mode::AmbientOcclusion)] {
+    for (label, mode) in
+        [("soft shadows", Technique::direct as fn(u32) -> Technique), ("AO", Technique::ambient_occlusion)]
+    {
         let reference = render_image(mode, args.reference_samples, SamplerKind::Sobol, 1000)?;
         for n in [16, 64, 256] {
             // Averaged over a few seeds so one lucky seed does not decide the comparison.

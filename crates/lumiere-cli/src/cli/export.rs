@@ -15,7 +15,7 @@ use lumiere::{Error, Result};
 
 pub fn export_ray_sets(dir: &Path, world: &World, sets: &[RaySet]) -> Result<()> {
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-    write_atomically(&dir.join("mesh.bin"), &mesh_bytes(&world.scene.mesh))?;
+    write_atomically(&dir.join("mesh.bin"), &mesh_bytes(&world.scene().mesh))?;
     for set in sets {
         let stem = format!("{}-{}", set.kind, set.query.name());
         let mut rays = header(b"LRAY", set.rays.len());

@@ -3,6 +3,7 @@ use std::time::Instant;
 use glam::Vec3;
 
 use lumiere::Result;
+use lumiere::lights::LightSet;
 use lumiere::scene::Scene;
 
 use super::args::InfoArgs;
@@ -15,15 +16,17 @@ pub fn run(args: &InfoArgs) -> Result<()> {
         eprintln!("lumiere: warning: {warning}");
     }
     let bounds = scene.bounds();
-    let light_area: f32 = scene.lights.iter().map(|l| l.area).sum();
-    let light_power: Vec3 = scene.lights.iter().map(|l| l.power()).sum();
+    let lights = LightSet::new(&scene);
+    let lights = lights.lights();
+    let light_area: f32 = lights.iter().map(|l| l.area).sum();
+    let light_power: Vec3 = lights.iter().map(|l| l.power()).sum();
     println!("scene      {}", scene.name);
     println!("triangles  {}", scene.mesh.triangle_count());
     println!("vertices   {}", scene.mesh.positions.len());
     println!("materials  {}", scene.materials.len());
     println!(
         "lights     {} triangles, area {light_area:.6}, power {:.6} {:.6} {:.6} W",
-        scene.lights.len(),
+        lights.len(),
         light_power.x,
         light_power.y,
         light_power.z

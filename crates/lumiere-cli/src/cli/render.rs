@@ -6,7 +6,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 use lumiere::accel::BuildPreset;
 use lumiere::image_io::{PngEncoding, check_output_path, write_image};
-use lumiere::integrators::LightSampling;
+use lumiere::integrators::{AmbientOcclusion, Direct, Hits, LightSampling, Materials, Shadows, Technique};
 use lumiere::render::checkpoint::Checkpoint;
 use lumiere::render::film::Film;
 use lumiere::render::fingerprint::{options_fingerprint, scene_fingerprint};
@@ -18,7 +18,7 @@ use lumiere::util::fs::{check_writable, write_atomically};
 use lumiere::world::World;
 use lumiere::{Error, Result};
 
-use super::args::{LightSamplingArg, RenderArgs, SamplerArg};
+use super::args::{LightSamplingArg, ModeArg, RenderArgs, SamplerArg};
 
 /// Exit code of a render stopped by SIGINT or SIGTERM (its image of completed samples is written).
 pub const EXIT_INTERRUPTED: u8 = 3;
@@ -104,7 +104,7 @@ fn render_in_pool(args: &RenderArgs, threads: usize) -> Result<u8> {
     let noise = output.film.relative_error().map_or(String::new(), |e| format!(", relative error {e:.4}"));
     eprintln!(
         "lumiere: {} {}x{}: {} after {} of {} spp{noise}; {:.1} ms ({threads} threads), {} rays, {:.1} Mrays/s -> {}",
-        options.mode.name(),
+        options.technique.name(),
         camera.width,
         camera.height,
         output.stop.describe(),
@@ -121,19 +121,19 @@ fn render_in_pool(args: &RenderArgs, threads: usize) -> Result<u8> {
 
     if let Some(path) = &args.stats_json {
         let stats = serde_json::json!({
-            "scene": world.scene.name,
-            "mode": options.mode.name(),
+            "scene": world.scene().name,
+            "mode": options.technique.name(),
             "width": camera.width,
             "height": camera.height,
-            "samples": options.samples,
+            "samples": args.samples,
             "spp": output.film.samples,
             "spp_requested": options.spp,
             "sampler": format!("{:?}", options.sampler).to_lowercase(),
             "seed": options.seed,
             "threads": threads,
-            "triangles": world.scene.mesh.triangle_count(),
-            "lights": world.scene.lights.len(),
-            "bvh_nodes": world.bvh.nodes().len(),
+            "triangles": world.scene().mesh.triangle_count(),
+            "lights": world.lights().lights().len(),
+            "bvh_nodes": world.bvh().nodes().len(),
             "load_ms": load_ms,
             "build_ms": build_ms,
             "render_ms": render_ms,
@@ -150,20 +150,31 @@ fn render_in_pool(args: &RenderArgs, threads: usize) -> Result<u8> {
 }
 
 fn render_options(args: &RenderArgs) -> RenderOptions {
+    let samples = args.samples;
+    let technique = match args.mode {
+        ModeArg::Hits => Technique::Hits(Hits),
+        ModeArg::Materials => Technique::Materials(Materials),
+        ModeArg::Shadows => Technique::Shadows(Shadows),
+        ModeArg::Direct => Technique::Direct(Direct {
+            samples,
+            light_sampling: match args.light_sampling {
+                LightSamplingArg::PerLight => LightSampling::PerLight,
+                LightSamplingArg::Power => LightSampling::Power,
+            },
+        }),
+        ModeArg::Ao => Technique::AmbientOcclusion(AmbientOcclusion {
+            samples,
+            distance: args.ao_distance.unwrap_or(f32::INFINITY),
+        }),
+    };
     RenderOptions {
-        mode: args.mode.into(),
-        samples: args.samples,
+        technique,
         spp: args.spp,
         seed: args.seed,
         sampler: match args.sampler {
             SamplerArg::Independent => SamplerKind::Independent,
             SamplerArg::Sobol => SamplerKind::Sobol,
         },
-        light_sampling: match args.light_sampling {
-            LightSamplingArg::PerLight => LightSampling::PerLight,
-            LightSamplingArg::Power => LightSampling::Power,
-        },
-        ao_distance: args.ao_distance.unwrap_or(f32::INFINITY),
         time_budget: args.time,
         noise_target: args.noise,
     }

@@ -15,12 +15,11 @@ use crate::process::{Limits, TempDir, check_exit, error_line, run};
 use flate2::Compression;
 use flate2::write::GzEncoder;
 use lumiere::Error;
-use lumiere::integrators::Mode;
+use lumiere::integrators::Technique;
 use lumiere::render::checkpoint::Checkpoint;
 use lumiere::render::{RenderOptions, render};
-use lumiere::scene::Scene;
 use lumiere::scene::camera::{Camera, Orbiter};
-use lumiere::scene::obj::{ObjScene, load_obj, parse_obj};
+use lumiere::scene::load::obj::{ObjScene, load_obj, parse_obj};
 use lumiere::world::World;
 use std::ffi::OsStr;
 use std::io::Write;
@@ -437,10 +436,11 @@ fn million_vertex_face_loads_as_a_fan_and_renders() {
         if relative {
             continue;
         }
-        let scene = Scene::from_obj(scene, "million.obj".to_string()).unwrap();
+        let scene = scene.into_scene("million.obj".to_string()).unwrap();
         let world = World::new(scene, Default::default());
         let camera = Camera::look_at(glam::Vec3::Z * 3.0, glam::Vec3::ZERO, glam::Vec3::Y, 60.0, 9, 9).unwrap();
-        let image = render(&world, &camera, &RenderOptions::new(Mode::Hits, 1), &|_| {}).unwrap().image;
+        let image =
+            render(&world, &camera, &RenderOptions::new(Technique::Hits(Default::default())), &|_| {}).unwrap().image;
         let pixel = |x: usize, y: usize| image.pixels[y * 9 + x].x;
         assert_eq!((pixel(4, 4), pixel(0, 0), pixel(8, 8)), (1.0, 0.0, 0.0), "a disk in the middle");
     }

@@ -6,7 +6,7 @@ use std::process::{Child, Command, Output, Stdio};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-use lumiere::integrators::Mode;
+use lumiere::integrators::Technique;
 use lumiere::render::film::Film;
 use lumiere::render::{Hooks, RenderOptions, RenderStats, StopReason, render, render_progressive};
 use lumiere::scene::camera::Camera;
@@ -42,7 +42,7 @@ fn small_world() -> (World, Camera) {
 #[test]
 fn stopping_at_s_samples_equals_asking_for_s() {
     let (world, camera) = small_world();
-    let options = RenderOptions { spp: 20, ..RenderOptions::new(Mode::Direct, 4) };
+    let options = RenderOptions { spp: 20, ..RenderOptions::new(Technique::direct(4)) };
     let cancel = AtomicBool::new(false);
     let mut passes = 0;
     let mut pass_done = |film: &Film, _: &RenderStats| {
@@ -67,7 +67,7 @@ fn stopping_at_s_samples_equals_asking_for_s() {
 fn noise_target_stops_early_with_the_error_reached() {
     let (world, camera) = small_world();
     let options =
-        RenderOptions { spp: 10_000, noise_target: Some(0.05), ..RenderOptions::new(Mode::AmbientOcclusion, 8) };
+        RenderOptions { spp: 10_000, noise_target: Some(0.05), ..RenderOptions::new(Technique::ambient_occlusion(8)) };
     let out = render(&world, &camera, &options, &|_| {}).unwrap();
     assert_eq!(out.stop, StopReason::NoiseTarget);
     assert!(out.film.samples < 10_000);
@@ -288,8 +288,8 @@ fn degenerate_scenes_render_finite_images() {
 #[test]
 fn shipped_scenes_discard_no_samples() {
     let (world, camera) = small_world();
-    for mode in [Mode::Shadows, Mode::Direct, Mode::AmbientOcclusion] {
-        let out = render(&world, &camera, &RenderOptions { spp: 2, ..RenderOptions::new(mode, 8) }, &|_| {}).unwrap();
+    for mode in [Technique::Shadows(Default::default()), Technique::direct(8), Technique::ambient_occlusion(8)] {
+        let out = render(&world, &camera, &RenderOptions { spp: 2, ..RenderOptions::new(mode) }, &|_| {}).unwrap();
         assert_eq!(out.film.discarded, 0, "{mode:?}");
     }
 }

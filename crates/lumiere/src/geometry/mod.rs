@@ -1,3 +1,4 @@
-//! Ray/primitive intersection.
+//! Ray/primitive intersection and the surface points it yields.
 
+pub mod surface;
 pub mod triangle;

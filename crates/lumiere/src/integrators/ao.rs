@@ -1,8 +1,8 @@
 use glam::Vec3;
 
-use super::{Integrator, SampleContext, dims};
+use super::{Integrator, SampleContext};
 use crate::accel::Region;
-use crate::math::{Frame, Ray, offset_ray_origin};
+use crate::math::{Frame, Ray};
 use crate::sampling::warp::sample_cosine_hemisphere;
 use crate::world::World;
 
@@ -11,6 +11,7 @@ use crate::world::World;
 ///
 /// With directions drawn with pdf `cos(theta)/pi`, the estimator of `(1/pi) * integral of V cos(theta)`
 /// is `(1/N) sum V`: every weight is exactly 1 (GI compendium eq. 35).
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AmbientOcclusion {
     pub samples: u32,
     /// Rays stop here; `f32::INFINITY` for the lab's "visibility of the sky".
@@ -23,16 +24,16 @@ impl Integrator for AmbientOcclusion {
         let Some(hit) = world.intersect(ray) else { return Vec3::ZERO };
         let surface = world.surface(ray, &hit);
         let frame = Frame::from_normal(surface.ng);
-        let origin = offset_ray_origin(surface.p, surface.ng);
-        // All probes leave from `origin` into the half-space above the surface: trace them as a batch.
+        let directions = ctx.stream.next_points(self.samples);
+        // All probes leave from one origin into the half-space above the surface: trace them as a batch.
+        let origin = surface.offset_origin(surface.ng);
         let mut batch = std::mem::take(&mut ctx.batch);
-        batch.prepare(&world.bvh, origin, &Region::hemisphere(origin, surface.ng));
+        world.prepare_batch(&mut batch, origin, &Region::hemisphere(origin, surface.ng));
         let mut visible = 0u32;
         for k in 0..self.samples {
-            let local = sample_cosine_hemisphere(ctx.point_2d(dims::HEMISPHERE, k, self.samples));
-            let direction = frame.to_world(local);
-            let probe = Ray { origin, dir: direction, tmax: self.distance };
-            visible += u32::from(!batch.occluded(&world.bvh, &probe));
+            let dir = frame.to_world(sample_cosine_hemisphere(directions.get_2d(k)));
+            let probe = Ray { origin, dir, tmax: self.distance };
+            visible += u32::from(!world.occluded_in_batch(&batch, &probe));
         }
         ctx.batch = batch;
         ctx.rays += u64::from(self.samples);

@@ -1,14 +1,12 @@
-use std::f32::consts::FRAC_1_PI;
-
 use glam::Vec3;
 
-use super::{Integrator, SampleContext, dims};
+use super::{Integrator, SampleContext, shading_frame};
 use crate::accel::Region;
-use crate::lights::AreaLight;
-use crate::math::{Ray, offset_ray_origin};
-use crate::sampling::distrib::AliasTable;
-use crate::sampling::warp::sample_uniform_triangle;
-use crate::world::{SurfacePoint, World};
+use crate::geometry::surface::SurfacePoint;
+use crate::lights::{AreaLight, LightSample, LightSelection};
+use crate::materials::Bsdf;
+use crate::math::{Frame, Ray};
+use crate::world::World;
 
 /// How the direct-light estimator spends its samples.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -16,50 +14,40 @@ pub enum LightSampling {
     /// N points on every light triangle, as the lab counts (N * lights shadow rays a pixel).
     #[default]
     PerLight,
-    /// N points in total, each on a light chosen in proportion to its power (alias table, O(1)).
+    /// N points in total, each on a light chosen in proportion to its power.
     Power,
 }
 
-/// Direct lighting from area lights with Lambertian receivers (lab figures 4-6):
-/// `Lr = (1/N) sum Le * Kd/pi * V * cos(theta) cos(theta_s) / d^2 / pdf(s)`, with `s` uniform on
-/// a light triangle (GI compendium eq. 18, area pdf `1/A`), or on a light picked by power (area pdf
-/// `pmf / A`). Where the camera sees a light directly, its emission.
+/// Direct lighting from area lights (lab figures 4-6): `Lr = (1/N) sum f Le V cos(theta) / pdf(wi)`,
+/// with light points drawn uniformly on a light triangle (the solid-angle pdf converts the area pdf
+/// `1/A`, GI compendium eq. 18), on every light in turn or on a light picked by power. Where the
+/// camera sees a light directly, its emission.
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Direct {
     pub samples: u32,
     pub light_sampling: LightSampling,
-    /// Built from the lights' power for `LightSampling::Power`; `None` when there are no lights.
-    power: Option<AliasTable>,
 }
 
-impl Direct {
-    pub fn new(world: &World, samples: u32, light_sampling: LightSampling) -> Direct {
-        let power = match light_sampling {
-            LightSampling::Power => {
-                let weights: Vec<f32> = world.scene.lights.iter().map(|l| l.power().element_sum()).collect();
-                AliasTable::new(&weights)
-            }
-            LightSampling::PerLight => None,
-        };
-        Direct { samples, light_sampling, power }
-    }
+/// The BSDF and geometry of the receiving point, shared by all its light samples.
+struct Receiver<'a, B> {
+    surface: &'a SurfacePoint,
+    bsdf: B,
+    frame: Frame,
+    wo: Vec3,
 }
 
-/// The unoccluded contribution of the light point `y` (sampled on the light's shadow-target
-/// triangle, a few ulps in front of it) to `surface`, divided by the area pdf, and the shadow
-/// segment that decides its visibility; `None` when a cosine is not positive.
-///
-/// `cos(theta) cos(theta_s) / d^2` is evaluated as `(n . v)(-n_s . v) / (v . v)^2` with the
-/// unnormalised `v = y - p`: no square root and one division per sample.
-#[inline(always)]
-fn light_sample(surface: &SurfacePoint, origin: Vec3, light: &AreaLight, y: Vec3) -> Option<(Vec3, Ray)> {
-    let v = y - surface.p;
-    let cos_surface = surface.ns.dot(v);
-    let cos_light = -light.normal.dot(v);
-    if cos_surface <= 0.0 || cos_light <= 0.0 || surface.ng.dot(v) <= 0.0 {
-        return None;
+impl<B: Bsdf> Receiver<'_, B> {
+    /// `f Le cos(theta) / pdf` of a light sample, before visibility; `None` when it cannot
+    /// contribute (below the surface, or a zero BSDF), so that no shadow ray is traced for it.
+    #[inline(always)]
+    fn unshadowed(&self, sample: &LightSample) -> Option<Vec3> {
+        let cos_surface = self.surface.ns.dot(sample.wi);
+        if cos_surface <= 0.0 || self.surface.ng.dot(sample.wi) <= 0.0 {
+            return None;
+        }
+        let f = self.bsdf.eval(self.wo, self.frame.to_local(sample.wi));
+        (f != Vec3::ZERO).then(|| f * sample.li * (cos_surface / sample.pdf))
     }
-    let d2 = v.length_squared();
-    Some((light.emission * (cos_surface * cos_light / (d2 * d2)), Ray::segment(origin, y)))
 }
 
 /// False when no point of the light can contribute: the light lies wholly below the surface's
@@ -70,21 +58,21 @@ fn faces_each_other(surface: &SurfacePoint, light: &AreaLight) -> bool {
     above && in_front
 }
 
-#[inline(always)]
-fn point_on(light: &AreaLight, u: glam::Vec2) -> Vec3 {
-    light.shadow_target(sample_uniform_triangle(u))
-}
-
 impl Integrator for Direct {
     fn radiance(&self, world: &World, ray: &Ray, ctx: &mut SampleContext) -> Vec3 {
         ctx.rays += 1;
         let Some(hit) = world.intersect(ray) else { return Vec3::ZERO };
-        let material = world.scene.material(hit.triangle);
+        let material = world.material(hit.triangle);
         if material.is_emissive() {
             return material.ke;
         }
         let surface = world.surface(ray, &hit);
-        let origin = offset_ray_origin(surface.p, surface.ng);
+        let (frame, wo) = shading_frame(surface.ns, ray);
+        let receiver = Receiver { surface: &surface, bsdf: material.bsdf(), frame, wo };
+        // Every shadow ray leaves above the geometric surface (the others are skipped), so they
+        // share one origin.
+        let origin = surface.offset_origin(surface.ng);
+        let lights = world.lights();
         let n = self.samples;
         let mut sum = Vec3::ZERO;
         match self.light_sampling {
@@ -92,40 +80,43 @@ impl Integrator for Direct {
                 // The N shadow rays towards one light triangle share their origin and stay in the shaft
                 // from it to the triangle: trace them as a batch.
                 let mut batch = std::mem::take(&mut ctx.batch);
-                for (index, light) in world.scene.lights.iter().enumerate() {
+                for (index, light) in lights.lights().iter().enumerate() {
+                    // Taken for every light, lit or not, so that each light keeps its dimension.
+                    let points = ctx.stream.next_points(n);
                     if !faces_each_other(&surface, light) {
                         continue;
                     }
                     let Some(shaft) = Region::shaft(origin, light.shadow_targets) else { continue };
-                    batch.prepare(&world.bvh, origin, &shaft);
-                    let dimension = dims::LIGHT_POINT + index as u32;
-                    let mut light_sum = Vec3::ZERO;
+                    world.prepare_batch(&mut batch, origin, &shaft);
                     for k in 0..n {
-                        let y = point_on(light, ctx.point_2d(dimension, k, n));
-                        let Some((contribution, shadow)) = light_sample(&surface, origin, light, y) else { continue };
+                        let Some(sample) = lights.sample_li_on(index as u32, surface.p, points.get_2d(k)) else {
+                            continue;
+                        };
+                        let Some(contribution) = receiver.unshadowed(&sample) else { continue };
                         ctx.rays += 1;
-                        if !batch.occluded(&world.bvh, &shadow) {
-                            light_sum += contribution;
+                        if !world.occluded_in_batch(&batch, &Ray::segment(origin, sample.target)) {
+                            sum += contribution;
                         }
                     }
-                    sum += light_sum * light.area;
                 }
                 ctx.batch = batch;
             }
             LightSampling::Power => {
-                let Some(table) = &self.power else { return Vec3::ZERO };
+                let (choices, points) = (ctx.stream.next_points(n), ctx.stream.next_points(n));
                 for k in 0..n {
-                    let choice = table.sample(ctx.point_1d(dims::LIGHT_CHOICE, k, n));
-                    let light = &world.scene.lights[choice.index];
-                    let y = point_on(light, ctx.point_2d(dims::LIGHT_POINT, k, n));
-                    let Some((contribution, shadow)) = light_sample(&surface, origin, light, y) else { continue };
+                    let u_light = choices.get_1d(k);
+                    let Some(sample) = lights.sample_li(LightSelection::Power, surface.p, u_light, points.get_2d(k))
+                    else {
+                        continue;
+                    };
+                    let Some(contribution) = receiver.unshadowed(&sample) else { continue };
                     ctx.rays += 1;
-                    if !world.occluded(&shadow) {
-                        sum += contribution * (light.area / choice.pmf);
+                    if !world.occluded(&Ray::segment(origin, sample.target)) {
+                        sum += contribution;
                     }
                 }
             }
         }
-        sum * material.kd * (FRAC_1_PI / n as f32)
+        sum / n as f32
     }
 }

@@ -5,6 +5,7 @@ use crate::math::Ray;
 use crate::world::World;
 
 /// White where the camera ray hits something, black elsewhere.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Hits;
 
 impl Integrator for Hits {

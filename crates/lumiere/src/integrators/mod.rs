@@ -1,4 +1,5 @@
-//! Integrators: one file per technique, all computing the radiance arriving along a camera ray.
+//! Integrators: one file per technique, each computing the radiance arriving along a camera ray.
+//! A technique's options are the fields of its integrator; [`Technique`] lists them all.
 
 mod ao;
 mod direct;
@@ -6,11 +7,12 @@ mod hits;
 mod materials;
 mod shadows;
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 
 use crate::accel::OriginBatch;
-use crate::math::Ray;
-use crate::sampler::Sampler;
+use crate::error::{Error, Result};
+use crate::math::{Frame, Ray};
+use crate::sampler::SampleStream;
 use crate::world::World;
 
 pub use ao::AmbientOcclusion;
@@ -19,79 +21,80 @@ pub use hits::Hits;
 pub use materials::Materials;
 pub use shadows::Shadows;
 
-/// What a render computes per pixel.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Mode {
+/// What a render computes per pixel, with the options of that technique.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Technique {
     /// 1 where the camera ray hits a triangle, 0 elsewhere (lab figure 1).
-    Hits,
-    /// Diffuse colour Kd of the hit triangle (lab figure 2).
-    Materials,
+    Hits(Hits),
+    /// The colour of the hit surface (lab figure 2).
+    Materials(Materials),
     /// Direct light from each light triangle's centroid, one shadow ray each (lab figure 3).
-    Shadows,
+    Shadows(Shadows),
     /// Direct light integrated over the area lights with N samples (lab figures 4-6).
-    Direct,
+    Direct(Direct),
     /// Ambient occlusion with N cosine-weighted directions (lab figures 7-9).
-    AmbientOcclusion,
+    AmbientOcclusion(AmbientOcclusion),
 }
 
-impl Mode {
-    pub fn name(self) -> &'static str {
+impl Technique {
+    /// The lab's soft shadows: `samples` points on every light triangle.
+    pub fn direct(samples: u32) -> Technique {
+        Technique::Direct(Direct { samples, light_sampling: LightSampling::PerLight })
+    }
+
+    /// The lab's ambient occlusion: `samples` directions, visibility of the sky.
+    pub fn ambient_occlusion(samples: u32) -> Technique {
+        Technique::AmbientOcclusion(AmbientOcclusion { samples, distance: f32::INFINITY })
+    }
+
+    /// The name of the technique on the command line (`--mode`).
+    pub fn name(&self) -> &'static str {
         match self {
-            Mode::Hits => "hits",
-            Mode::Materials => "materials",
-            Mode::Shadows => "shadows",
-            Mode::Direct => "direct",
-            Mode::AmbientOcclusion => "ao",
+            Technique::Hits(_) => "hits",
+            Technique::Materials(_) => "materials",
+            Technique::Shadows(_) => "shadows",
+            Technique::Direct(_) => "direct",
+            Technique::AmbientOcclusion(_) => "ao",
+        }
+    }
+
+    /// Refuses options no render could use.
+    pub fn validate(&self) -> Result<()> {
+        match *self {
+            Technique::Direct(Direct { samples: 0, .. })
+            | Technique::AmbientOcclusion(AmbientOcclusion { samples: 0, .. }) => {
+                Err(Error::invalid("--samples must be at least 1"))
+            }
+            Technique::AmbientOcclusion(AmbientOcclusion { distance, .. }) if distance.is_nan() || distance <= 0.0 => {
+                Err(Error::invalid(format!("--ao-distance must be positive, got {distance}")))
+            }
+            _ => Ok(()),
         }
     }
 }
 
-/// Sample dimensions, numbered once here so that no two uses of the sampler collide.
-pub mod dims {
-    /// Position inside the pixel (anti-aliasing jitter).
-    pub const PIXEL: u32 = 0;
-    /// Which light, for power-proportional light selection.
-    pub const LIGHT_CHOICE: u32 = 1;
-    /// Hemisphere direction, for ambient occlusion.
-    pub const HEMISPHERE: u32 = 2;
-    /// Point on a light; per-light sampling uses `LIGHT_POINT + light index`.
-    pub const LIGHT_POINT: u32 = 3;
-}
-
-/// Per-sample state handed to an integrator: where the sample is, its random numbers, and a count
+/// Per-sample state handed to an integrator: its random numbers, reusable scratch space, and a count
 /// of the rays it traces (visibility queries included).
 #[derive(Debug)]
 pub struct SampleContext<'a> {
-    pub sampler: &'a Sampler,
+    /// This camera sample's random numbers; the pixel position has taken the first dimension.
+    pub stream: SampleStream<'a>,
     /// Reused buffer for shared-origin ray batches (one per thread, never shared).
     pub batch: OriginBatch,
-    /// `y * width + x`.
-    pub pixel: u32,
-    /// Index of this camera sample within its pixel (0 .. spp).
-    pub sample: u32,
     pub rays: u64,
-}
-
-impl<'a> SampleContext<'a> {
-    pub fn new(sampler: &'a Sampler) -> Self {
-        SampleContext { sampler, batch: OriginBatch::default(), pixel: 0, sample: 0, rays: 0 }
-    }
-
-    /// The `k`-th of `n` 2D points of `dimension` for this camera sample. Consecutive camera samples
-    /// own consecutive blocks of `n` indices, so a stratified sampler stratifies across all of them.
-    #[inline]
-    pub fn point_2d(&self, dimension: u32, k: u32, n: u32) -> Vec2 {
-        self.sampler.get_2d(self.pixel, self.sample * n + k, dimension)
-    }
-
-    #[inline]
-    pub fn point_1d(&self, dimension: u32, k: u32, n: u32) -> f32 {
-        self.sampler.get_1d(self.pixel, self.sample * n + k, dimension)
-    }
 }
 
 /// Radiance along a camera ray. Implemented by plain structs and used through generics, so the
 /// per-ray path has no dynamic dispatch.
 pub trait Integrator: Sync {
     fn radiance(&self, world: &World, ray: &Ray, ctx: &mut SampleContext) -> Vec3;
+}
+
+/// The shading frame at a surface (`z` = the shading normal) and the direction towards the viewer
+/// in it, for BSDF evaluation.
+#[inline]
+fn shading_frame(ns: Vec3, ray: &Ray) -> (Frame, Vec3) {
+    let frame = Frame::from_normal(ns);
+    let wo = frame.to_local(-ray.dir.normalize());
+    (frame, wo)
 }

@@ -1,29 +1,29 @@
-use std::f32::consts::FRAC_1_PI;
-
 use glam::Vec3;
 
-use super::{Integrator, SampleContext};
-use crate::math::{Ray, offset_ray_origin};
+use super::{Integrator, SampleContext, shading_frame};
+use crate::materials::Bsdf;
+use crate::math::Ray;
 use crate::world::World;
 
 /// The lab's hard shadows: every light triangle acts as a point light at its centroid carrying the
-/// triangle's area, `L = sum Ke * Kd/pi * cos(theta) * cos(theta_light) * area / d^2 * V`.
+/// triangle's area, `L = sum Ke * f * cos(theta) * cos(theta_light) * area / d^2 * V`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Shadows;
 
 impl Integrator for Shadows {
     fn radiance(&self, world: &World, ray: &Ray, ctx: &mut SampleContext) -> Vec3 {
         ctx.rays += 1;
         let Some(hit) = world.intersect(ray) else { return Vec3::ZERO };
-        let surface = world.surface(ray, &hit);
-        let material = world.scene.material(hit.triangle);
+        let material = world.material(hit.triangle);
         if material.is_emissive() {
             return material.ke;
         }
-        let origin = offset_ray_origin(surface.p, surface.ng);
+        let surface = world.surface(ray, &hit);
+        let bsdf = material.bsdf();
+        let (frame, wo) = shading_frame(surface.ns, ray);
         let mut sum = Vec3::ZERO;
-        for light in &world.scene.lights {
-            let centroid = light.centroid();
-            let to_light = centroid - surface.p;
+        for light in world.lights().lights() {
+            let to_light = light.centroid() - surface.p;
             let d2 = to_light.length_squared();
             let wi = to_light / d2.sqrt();
             let cos_surface = surface.ns.dot(wi);
@@ -34,11 +34,12 @@ impl Integrator for Shadows {
             // The segment ends on the light's shadow-target triangle, just in front of the light.
             let target = light.shadow_target(Vec3::splat(1.0 / 3.0));
             ctx.rays += 1;
-            if world.occluded(&Ray::segment(origin, target)) {
+            if world.occluded(&surface.spawn_segment(target)) {
                 continue;
             }
-            sum += light.emission * cos_surface * cos_light * light.area / d2;
+            let f = bsdf.eval(wo, frame.to_local(wi));
+            sum += f * light.emission * (cos_surface * cos_light * light.area / d2);
         }
-        sum * material.kd * FRAC_1_PI
+        sum
     }
 }

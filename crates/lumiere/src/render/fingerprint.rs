@@ -27,20 +27,12 @@ pub fn scene_fingerprint(scene: &Scene) -> u64 {
     h.finish()
 }
 
-/// Everything that decides a sample's value: mode, sample counts per camera sample, seed, sampler,
-/// camera and image size. Not the target spp nor the budgets, which a resumed render may change.
+/// Everything that decides a sample's value: the technique and its options, seed, sampler, camera
+/// and image size. Not the target spp nor the budgets, which a resumed render may change.
 pub fn options_fingerprint(options: &RenderOptions, camera: &Camera) -> u64 {
     let mut h = StableHasher::default();
     // Debug output of these plain records is exact (floats print in shortest round-trip form).
-    let described = format!(
-        "{:?} {} {} {:?} {:?} {} {camera:?}",
-        options.mode,
-        options.samples,
-        options.seed,
-        options.sampler,
-        options.light_sampling,
-        options.ao_distance.to_bits()
-    );
+    let described = format!("{:?} {} {:?} {camera:?}", options.technique, options.seed, options.sampler);
     h.write(described.as_bytes());
     h.finish()
 }

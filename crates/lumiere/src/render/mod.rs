@@ -6,6 +6,9 @@
 pub mod checkpoint;
 pub mod film;
 pub mod fingerprint;
+mod options;
+
+pub use options::RenderOptions;
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
@@ -13,11 +16,10 @@ use std::time::{Duration, Instant};
 use glam::Vec3;
 use rayon::prelude::*;
 
+use crate::accel::OriginBatch;
 use crate::error::{Error, Result};
-use crate::integrators::{
-    AmbientOcclusion, Direct, Hits, Integrator, LightSampling, Materials, Mode, SampleContext, Shadows, dims,
-};
-use crate::sampler::{Sampler, SamplerKind};
+use crate::integrators::{Integrator, SampleContext, Technique};
+use crate::sampler::{SampleStream, Sampler};
 use crate::scene::camera::Camera;
 use crate::world::World;
 use film::{Film, Image};
@@ -25,61 +27,6 @@ use film::{Film, Image};
 /// Tiles are small enough to balance two cores and to notice an interruption within milliseconds,
 /// and large enough that scheduling costs nothing.
 const TILE_SIZE: u32 = 16;
-
-#[derive(Clone, Debug, PartialEq)]
-pub struct RenderOptions {
-    pub mode: Mode,
-    /// Samples per light (or in total, with power light sampling) or per hemisphere.
-    pub samples: u32,
-    /// Camera samples per pixel to reach; 1 is the lab's single ray through the pixel centre,
-    /// more are jittered inside the pixel.
-    pub spp: u32,
-    pub seed: u64,
-    pub sampler: SamplerKind,
-    pub light_sampling: LightSampling,
-    /// Ambient occlusion rays stop at this distance (infinite: visibility of the sky).
-    pub ao_distance: f32,
-    /// Stop after the pass that crosses this much rendering time.
-    pub time_budget: Option<Duration>,
-    /// Stop once the image's estimated relative standard error is below this.
-    pub noise_target: Option<f64>,
-}
-
-impl RenderOptions {
-    /// The options of a lab image: one camera ray per pixel centre, independent samples, no budget.
-    pub fn new(mode: Mode, samples: u32) -> Self {
-        RenderOptions {
-            mode,
-            samples,
-            spp: 1,
-            seed: 0,
-            sampler: SamplerKind::Independent,
-            light_sampling: LightSampling::PerLight,
-            ao_distance: f32::INFINITY,
-            time_budget: None,
-            noise_target: None,
-        }
-    }
-
-    fn validate(&self, camera: &Camera) -> Result<()> {
-        if camera.width == 0 || camera.height == 0 {
-            return Err(Error::invalid(format!("image size {}x{} has no pixels", camera.width, camera.height)));
-        }
-        if self.samples == 0 {
-            return Err(Error::invalid("--samples must be at least 1"));
-        }
-        if self.spp == 0 {
-            return Err(Error::invalid("--spp must be at least 1"));
-        }
-        if self.ao_distance.is_nan() || self.ao_distance <= 0.0 {
-            return Err(Error::invalid(format!("--ao-distance must be positive, got {}", self.ao_distance)));
-        }
-        if self.noise_target.is_some_and(|n| n.is_nan() || n <= 0.0) {
-            return Err(Error::invalid("--noise must be positive"));
-        }
-        Ok(())
-    }
-}
 
 /// Why a render stopped.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -166,18 +113,13 @@ pub fn render_progressive(
             film.width, film.height, camera.width, camera.height
         )));
     }
-    let n = options.samples;
-    match options.mode {
-        Mode::Hits => run_passes(&Hits, world, camera, options, film, stats, hooks),
-        Mode::Materials => run_passes(&Materials, world, camera, options, film, stats, hooks),
-        Mode::Shadows => run_passes(&Shadows, world, camera, options, film, stats, hooks),
-        Mode::Direct => {
-            run_passes(&Direct::new(world, n, options.light_sampling), world, camera, options, film, stats, hooks)
-        }
-        Mode::AmbientOcclusion => {
-            let ao = AmbientOcclusion { samples: n, distance: options.ao_distance };
-            run_passes(&ao, world, camera, options, film, stats, hooks)
-        }
+    // One monomorphised render loop per technique: no dynamic dispatch per sample.
+    match &options.technique {
+        Technique::Hits(hits) => run_passes(hits, world, camera, options, film, stats, hooks),
+        Technique::Materials(materials) => run_passes(materials, world, camera, options, film, stats, hooks),
+        Technique::Shadows(shadows) => run_passes(shadows, world, camera, options, film, stats, hooks),
+        Technique::Direct(direct) => run_passes(direct, world, camera, options, film, stats, hooks),
+        Technique::AmbientOcclusion(ao) => run_passes(ao, world, camera, options, film, stats, hooks),
     }
 }
 
@@ -247,14 +189,16 @@ fn render_pass<I: Integrator>(
             if hooks.cancel.load(Ordering::Relaxed) {
                 return None;
             }
-            let mut ctx = SampleContext::new(sampler);
-            ctx.sample = sample;
+            let mut ctx =
+                SampleContext { stream: SampleStream::new(sampler, 0, sample), batch: OriginBatch::default(), rays: 0 };
             let mut values = Vec::with_capacity(((tile.x1 - tile.x0) * (tile.y1 - tile.y0)) as usize);
             for y in tile.y0..tile.y1 {
                 for x in tile.x0..tile.x1 {
-                    ctx.pixel = y * camera.width + x;
-                    // One sample: the pixel centre, as the lab did; more: jittered in the pixel.
-                    let offset = if spp == 1 { glam::Vec2::splat(0.5) } else { ctx.point_2d(dims::PIXEL, 0, 1) };
+                    ctx.stream = SampleStream::new(sampler, y * camera.width + x, sample);
+                    // The first dimension is the position in the pixel. One sample: the pixel centre, as
+                    // the lab did; more: jittered in the pixel.
+                    let jitter = ctx.stream.next_points(1);
+                    let offset = if spp == 1 { glam::Vec2::splat(0.5) } else { jitter.get_2d(0) };
                     let ray = camera.ray(x as f32 + offset.x, y as f32 + offset.y);
                     values.push(integrator.radiance(world, &ray, &mut ctx));
                 }

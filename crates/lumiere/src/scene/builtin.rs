@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use super::camera::Orbiter;
-use super::obj::{ObjScene, parse_obj};
+use super::load::obj::{ObjScene, parse_obj};
 use crate::error::Result;
 
 const OBJ: &[u8] = include_bytes!("../../assets/cornell/cornell.obj");

@@ -1,54 +1,67 @@
-//! Everything a render needs to know about the world: triangles, materials, lights, camera.
+//! What a render is about: triangles and their materials, in a format-neutral [`Scene`], and the
+//! camera. Loaders (`load/`) turn files into scenes; the built-in scene is embedded.
 
 pub mod builtin;
 pub mod camera;
-pub mod material;
+pub mod load;
 pub mod mesh;
-pub mod obj;
 
 use std::path::Path;
 
 use glam::Vec3;
 
 use crate::error::{Error, Result};
-use crate::lights::{AreaLight, collect_lights};
+use crate::materials::Material;
 use crate::math::Aabb;
-use material::Material;
 use mesh::TriangleMesh;
-use obj::ObjScene;
 
-/// A loaded scene: triangles in file order, their materials and the lights derived from them.
+/// A loaded scene: triangles in file order and their materials. Lights, the BVH and everything
+/// else derived from it are built once in `World::new`.
 #[derive(Clone, Debug)]
 pub struct Scene {
     pub name: String,
     pub mesh: TriangleMesh,
     pub materials: Vec<Material>,
-    pub lights: Vec<AreaLight>,
     /// Non-fatal problems met while loading (missing MTL, unknown material), for the user to see.
     pub warnings: Vec<String>,
 }
 
 impl Scene {
-    /// Loads an OBJ (or `.obj.gz`) file with its MTL files.
+    /// Loads a scene file, choosing the loader by its extension (see [`load::load`]).
     pub fn load(path: &Path) -> Result<Scene> {
-        Scene::from_obj(obj::load_obj(path)?, path.display().to_string())
+        load::load(path)
     }
 
     /// gKit's Cornell box, embedded in the binary.
     pub fn builtin() -> Result<Scene> {
-        Scene::from_obj(builtin::cornell_box()?, builtin::NAME.to_string())
+        builtin::cornell_box()?.into_scene(builtin::NAME.to_string())
     }
 
-    pub fn from_obj(obj: ObjScene, name: String) -> Result<Scene> {
-        let ObjScene { mesh, materials, warnings } = obj;
+    /// A scene from its parts, whatever their source (a file loader, a binding, a test); refuses
+    /// parts that do not fit together (an index or material id out of range).
+    pub fn from_parts(
+        name: String,
+        mesh: TriangleMesh,
+        materials: Vec<Material>,
+        warnings: Vec<String>,
+    ) -> Result<Scene> {
         if let Some(bad) = mesh.material_ids.iter().find(|&&m| m as usize >= materials.len()) {
             return Err(Error::invalid(format!("{name}: material id {bad} out of range")));
         }
-        let lights = collect_lights(&mesh, &materials);
-        Ok(Scene { name, mesh, materials, lights, warnings })
+        if mesh.material_ids.len() != mesh.indices.len() {
+            return Err(Error::invalid(format!(
+                "{name}: {} triangles but {} material ids",
+                mesh.indices.len(),
+                mesh.material_ids.len()
+            )));
+        }
+        if let Some(bad) = mesh.indices.iter().flatten().find(|&&i| i as usize >= mesh.positions.len()) {
+            return Err(Error::invalid(format!("{name}: vertex index {bad} out of range")));
+        }
+        Ok(Scene { name, mesh, materials, warnings })
     }
 
-    /// Sets the emission of every material called `name` and recomputes the lights.
+    /// Sets the emission of every material called `name`.
     pub fn set_emission(&mut self, name: &str, emission: Vec3) -> Result<()> {
         let mut found = false;
         for material in self.materials.iter_mut().filter(|m| m.name == name) {
@@ -58,7 +71,6 @@ impl Scene {
         if !found {
             return Err(Error::invalid(format!("{}: no material named '{name}'", self.name)));
         }
-        self.lights = collect_lights(&self.mesh, &self.materials);
         Ok(())
     }
 

@@ -3,12 +3,12 @@
 
 use glam::Vec3;
 use lumiere::accel::BuildPreset;
-use lumiere::integrators::{LightSampling, Mode};
+use lumiere::integrators::{Direct, LightSampling, Technique};
+use lumiere::materials::Material;
 use lumiere::render::{RenderOptions, render};
 use lumiere::sampler::SamplerKind;
 use lumiere::scene::Scene;
 use lumiere::scene::camera::Camera;
-use lumiere::scene::material::Material;
 use lumiere::scene::mesh::TriangleMesh;
 use lumiere::world::World;
 
@@ -22,8 +22,7 @@ fn scene_of_quads(quads: &[([Vec3; 4], usize)], materials: Vec<Material>) -> Wor
         mesh.indices.push([base, base + 2, base + 3]);
         mesh.material_ids.extend([*material as u32; 2]);
     }
-    let scene = Scene::from_obj(lumiere::scene::obj::ObjScene { mesh, materials, warnings: vec![] }, "test".into())
-        .expect("valid test scene");
+    let scene = Scene::from_parts("test".into(), mesh, materials, vec![]).expect("valid test scene");
     World::new(scene, BuildPreset::Default)
 }
 
@@ -57,7 +56,7 @@ fn mean_and_error(seeds: u64, mut f: impl FnMut(u64) -> f32) -> (f64, f64) {
 }
 
 fn ao_options(samples: u32, seed: u64) -> RenderOptions {
-    RenderOptions { seed, ..RenderOptions::new(Mode::AmbientOcclusion, samples) }
+    RenderOptions { seed, ..RenderOptions::new(Technique::ambient_occlusion(samples)) }
 }
 
 #[test]
@@ -75,11 +74,7 @@ fn ao_of_an_open_plane_is_exactly_one() {
 fn ao_inside_a_closed_box_is_exactly_zero() {
     let (positions, indices) = crate::common::grid_cube(3);
     let mesh = TriangleMesh { material_ids: vec![0; indices.len()], positions, indices, ..Default::default() };
-    let scene = Scene::from_obj(
-        lumiere::scene::obj::ObjScene { mesh, materials: vec![diffuse(0.5)], warnings: vec![] },
-        "box".into(),
-    )
-    .unwrap();
+    let scene = Scene::from_parts("box".into(), mesh, vec![diffuse(0.5)], vec![]).unwrap();
     let world = World::new(scene, BuildPreset::Default);
     let camera = Camera::look_at(Vec3::new(0.1, 0.2, 0.3), Vec3::new(1.0, -0.5, -1.0), Vec3::Y, 90.0, 16, 16).unwrap();
     let out = render(&world, &camera, &ao_options(64, 2), &|_| {}).unwrap();
@@ -120,7 +115,7 @@ fn square_form_factor(a: f64, h: f64) -> f64 {
 }
 
 fn direct_options(samples: u32, seed: u64, sampler: SamplerKind, light_sampling: LightSampling) -> RenderOptions {
-    RenderOptions { seed, sampler, light_sampling, ..RenderOptions::new(Mode::Direct, samples) }
+    RenderOptions { seed, sampler, ..RenderOptions::new(Technique::Direct(Direct { samples, light_sampling })) }
 }
 
 /// Outgoing radiance of a white Lambertian floor under a square light: `Kd * Le * F`.
@@ -158,8 +153,7 @@ fn power_light_sampling_is_unbiased_with_unequal_lights() {
     mesh.indices = vec![[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]];
     mesh.material_ids = vec![0, 0, 1, 2];
     let materials = vec![diffuse(kd), emitter(5.0), emitter(40.0)];
-    let scene =
-        Scene::from_obj(lumiere::scene::obj::ObjScene { mesh, materials, warnings: vec![] }, "two".into()).unwrap();
+    let scene = Scene::from_parts("two".into(), mesh, materials, vec![]).unwrap();
     let world = World::new(scene, BuildPreset::Default);
     let expected = kd as f64 * (5.0 + 40.0) * 0.5 * square_form_factor(a as f64, h as f64);
     let options = |seed| direct_options(512, seed, SamplerKind::Independent, LightSampling::Power);

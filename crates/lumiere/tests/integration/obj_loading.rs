@@ -5,8 +5,8 @@ use crate::common::TempDir;
 use flate2::Compression;
 use flate2::write::GzEncoder;
 use glam::{Vec2, Vec3};
+use lumiere::scene::load::obj::{ObjScene, load_obj, parse_obj, parse_obj_with_chunk_size};
 use lumiere::scene::mesh::NO_INDEX;
-use lumiere::scene::obj::{ObjScene, load_obj, parse_obj, parse_obj_with_chunk_size};
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -58,7 +58,7 @@ fn load_shared(relative: &str) -> Option<ObjScene> {
     Some(scene)
 }
 
-fn material_of(scene: &ObjScene, triangle: usize) -> &lumiere::scene::material::Material {
+fn material_of(scene: &ObjScene, triangle: usize) -> &lumiere::materials::Material {
     &scene.materials[scene.mesh.material_ids[triangle] as usize]
 }
 
@@ -135,7 +135,7 @@ fn faces_before_usemtl_get_the_default_material_only_when_they_exist() {
     let names: Vec<&str> = with_default.materials.iter().map(|m| m.name.as_str()).collect();
     assert_eq!(names, ["red", "blue", "default"]);
     assert_eq!(with_default.mesh.material_ids, vec![2, 1]);
-    assert_eq!(with_default.materials[2], lumiere::scene::material::Material::default_grey("default"));
+    assert_eq!(with_default.materials[2], lumiere::materials::Material::default_grey("default"));
     assert!(with_default.warnings.is_empty(), "{:?}", with_default.warnings);
 
     let without = parse_with(&format!("mtllib m.mtl\n{SQUARE}usemtl red\nf 1 2 3\n"), &[("m.mtl", mtl)]);
@@ -159,7 +159,7 @@ fn missing_mtl_warns_and_uses_grey() {
     let obj = dir.write("scene.obj", format!("mtllib nowhere.mtl\n{SQUARE}usemtl red\nf 1 2 3\n").as_bytes());
     let scene = load_obj(&obj).expect("load");
     assert_eq!(scene.materials.len(), 1);
-    assert_eq!(scene.materials[0], lumiere::scene::material::Material::default_grey("red"));
+    assert_eq!(scene.materials[0], lumiere::materials::Material::default_grey("red"));
     assert!(
         scene.warnings.iter().any(|w| w.contains("nowhere.mtl") && w.contains("scene.obj:1:")),
         "{:?}",
@@ -374,7 +374,7 @@ fn mcguire_cornell_box() {
 fn stanford_bunny() {
     let Some(scene) = load_shared("bunny/stanford-bunny.obj") else { return };
     assert_eq!(scene.mesh.triangle_count(), 69_451);
-    assert_eq!(scene.materials, [lumiere::scene::material::Material::default_grey("default")]);
+    assert_eq!(scene.materials, [lumiere::materials::Material::default_grey("default")]);
     assert!(scene.mesh.material_ids.iter().all(|&id| id == 0));
     assert!(scene.warnings.is_empty());
 }

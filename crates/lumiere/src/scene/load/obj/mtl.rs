@@ -2,7 +2,7 @@
 //! because a render with one wrong material is more useful than no render.
 
 use super::text::{Tokens, finite_f32, lines, quoted};
-use crate::scene::material::Material;
+use crate::materials::Material;
 use glam::Vec3;
 use std::path::{Path, PathBuf};
 

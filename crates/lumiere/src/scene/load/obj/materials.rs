@@ -3,7 +3,7 @@
 
 use super::chunk::MaterialLibrary;
 use super::mtl::parse_mtl;
-use crate::scene::material::Material;
+use crate::materials::Material;
 use std::collections::{HashMap, HashSet};
 use std::io;
 use std::path::{Path, PathBuf};

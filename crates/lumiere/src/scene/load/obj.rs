@@ -14,7 +14,8 @@ mod mtl;
 mod text;
 
 use crate::error::{Error, Result};
-use crate::scene::material::Material;
+use crate::materials::Material;
+use crate::scene::Scene;
 use crate::scene::mesh::{NO_INDEX, TriangleMesh};
 use crate::util::fs;
 use chunk::{ChunkCounts, ChunkMesh, ChunkStart, VertexCounts, parse_chunk};
@@ -34,6 +35,13 @@ pub struct ObjScene {
     pub mesh: TriangleMesh,
     pub materials: Vec<Material>,
     pub warnings: Vec<String>,
+}
+
+impl ObjScene {
+    /// The scene these parts make, named `name` in messages (see [`Scene::from_parts`]).
+    pub fn into_scene(self, name: String) -> Result<Scene> {
+        Scene::from_parts(name, self.mesh, self.materials, self.warnings)
+    }
 }
 
 /// Loads `path` (`.obj` or `.obj.gz`); `mtllib` files resolve relative to the OBJ's folder.

@@ -1,6 +1,9 @@
-//! Surface description read from MTL files. Only what the integrators use or will use is kept.
+//! The format-neutral description of a surface, as scene loaders fill it (from MTL statements
+//! today). Integrators never read it directly: they ask it for its [`Bsdf`](super::Bsdf).
 
 use glam::Vec3;
+
+use super::Lambert;
 use std::path::PathBuf;
 
 #[derive(Clone, Debug, PartialEq)]
@@ -41,5 +44,13 @@ impl Material {
 
     pub fn is_emissive(&self) -> bool {
         self.ke.max_element() > 0.0
+    }
+}
+
+impl Material {
+    /// The scattering function of this material: Lambertian reflection of `kd` (the only lobe so far).
+    #[inline]
+    pub fn bsdf(&self) -> Lambert {
+        Lambert { reflectance: self.kd }
     }
 }

@@ -1,11 +1,10 @@
-//! Emissive triangles as area lights.
+//! One emissive triangle as an area light.
 
 use glam::Vec3;
 
 use crate::geometry::triangle::{triangle_area, triangle_normal};
 use crate::math::offset_ray_origin;
-use crate::scene::material::Material;
-use crate::scene::mesh::TriangleMesh;
+use crate::scene::Scene;
 
 /// One emissive triangle. It emits `emission` (radiance) from the side its unit `normal` points to
 /// (the winding `p0 -> p1 -> p2`), as gKit's and McGuire's boxes orient their lights.
@@ -39,20 +38,15 @@ impl AreaLight {
     pub fn power(&self) -> Vec3 {
         std::f32::consts::PI * self.area * self.emission
     }
-
-    /// Radiance leaving the light towards direction `w` (pointing away from the light).
-    #[inline]
-    pub fn radiance_towards(&self, w: Vec3) -> Vec3 {
-        if self.normal.dot(w) > 0.0 { self.emission } else { Vec3::ZERO }
-    }
 }
 
-/// Every emissive triangle of a mesh, in triangle id order. Zero-area triangles are skipped: they
+/// Every emissive triangle of a scene, in triangle id order. Zero-area triangles are skipped: they
 /// emit nothing and have no normal.
-pub fn collect_lights(mesh: &TriangleMesh, materials: &[Material]) -> Vec<AreaLight> {
+pub(super) fn collect_lights(scene: &Scene) -> Vec<AreaLight> {
+    let mesh = &scene.mesh;
     (0..mesh.triangle_count())
         .filter_map(|id| {
-            let emission = materials[mesh.material_ids[id] as usize].ke;
+            let emission = scene.material(id as u32).ke;
             if emission.max_element() <= 0.0 {
                 return None;
             }

@@ -1,0 +1,47 @@
+//! The point where a ray met a surface, with what shading needs and how rays leave it.
+
+use glam::{Vec2, Vec3};
+
+use crate::math::{Ray, offset_ray_origin};
+
+/// What an integrator knows about a hit point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfacePoint {
+    /// Position, interpolated from the vertices (more accurate than `origin + t * dir`).
+    pub p: Vec3,
+    /// Unit geometric normal, turned towards the side the ray came from. Decides which side a ray
+    /// leaves on; never used for shading.
+    pub ng: Vec3,
+    /// Unit shading normal (interpolated vertex normals when the file has them, else `ng`), on
+    /// `ng`'s side.
+    pub ns: Vec3,
+    /// Texture coordinates interpolated from the file's `vt` (zero when it has none).
+    pub uv: Vec2,
+    pub triangle: u32,
+    /// Index of the triangle's material in the scene.
+    pub material: u32,
+}
+
+impl SurfacePoint {
+    /// A ray from this point in direction `dir`, its origin moved off the surface a few ulps to
+    /// the side `dir` leaves on (Wächter and Binder; pbrt's `SpawnRay`): no scene-scale epsilon,
+    /// and no self-intersection on either side.
+    #[inline]
+    pub fn spawn_ray(&self, dir: Vec3) -> Ray {
+        Ray::new(self.offset_origin(dir), dir)
+    }
+
+    /// The segment from this point (offset to the side of `target`) to `target`, ending exactly at
+    /// `t = 1`: a shadow ray.
+    #[inline]
+    pub fn spawn_segment(&self, target: Vec3) -> Ray {
+        Ray::segment(self.offset_origin(target - self.p), target)
+    }
+
+    /// The origin for rays leaving towards `dir`: `p` moved off the surface on `dir`'s side.
+    #[inline]
+    pub fn offset_origin(&self, dir: Vec3) -> Vec3 {
+        let side = if self.ng.dot(dir) >= 0.0 { self.ng } else { -self.ng };
+        offset_ray_origin(self.p, side)
+    }
+}

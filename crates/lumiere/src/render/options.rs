@@ -1,0 +1,51 @@
+//! What a render is asked to do: the technique with its own options, and what every technique
+//! shares (samples per pixel, seed, sampler, budgets).
+
+use std::time::Duration;
+
+use crate::error::{Error, Result};
+use crate::integrators::Technique;
+use crate::sampler::SamplerKind;
+use crate::scene::camera::Camera;
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderOptions {
+    pub technique: Technique,
+    /// Camera samples per pixel to reach; 1 is the lab's single ray through the pixel centre,
+    /// more are jittered inside the pixel.
+    pub spp: u32,
+    pub seed: u64,
+    pub sampler: SamplerKind,
+    /// Stop after the pass that crosses this much rendering time.
+    pub time_budget: Option<Duration>,
+    /// Stop once the image's estimated relative standard error is below this.
+    pub noise_target: Option<f64>,
+}
+
+impl RenderOptions {
+    /// The options of a lab image: one camera ray per pixel centre, independent samples, no budget.
+    pub fn new(technique: Technique) -> Self {
+        RenderOptions {
+            technique,
+            spp: 1,
+            seed: 0,
+            sampler: SamplerKind::Independent,
+            time_budget: None,
+            noise_target: None,
+        }
+    }
+
+    pub(super) fn validate(&self, camera: &Camera) -> Result<()> {
+        if camera.width == 0 || camera.height == 0 {
+            return Err(Error::invalid(format!("image size {}x{} has no pixels", camera.width, camera.height)));
+        }
+        self.technique.validate()?;
+        if self.spp == 0 {
+            return Err(Error::invalid("--spp must be at least 1"));
+        }
+        if self.noise_target.is_some_and(|n| n.is_nan() || n <= 0.0) {
+            return Err(Error::invalid("--noise must be positive"));
+        }
+        Ok(())
+    }
+}

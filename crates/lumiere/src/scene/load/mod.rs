@@ -1,0 +1,30 @@
+//! Scene files in: the loader is chosen by the file's extension, and every loader hands its
+//! triangles, materials and warnings to [`Scene::from_parts`]. Loaders know nothing of rendering.
+
+pub mod obj;
+
+use std::path::Path;
+
+use crate::error::{Error, Result};
+use crate::scene::Scene;
+
+/// The scene formats lumiere reads, named as in messages.
+const SUPPORTED: &str = ".obj or .obj.gz (with their .mtl files)";
+
+/// Loads the scene file at `path`, choosing the loader by its extension (case-insensitive).
+pub fn load(path: &Path) -> Result<Scene> {
+    let name = path.file_name().map(|n| n.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
+    let stem = name.strip_suffix(".gz").unwrap_or(&name);
+    let extension = Path::new(stem).extension().map(|e| e.to_string_lossy().into_owned()).unwrap_or_default();
+    match extension.as_str() {
+        "obj" => obj::load_obj(path)?.into_scene(path.display().to_string()),
+        "" => Err(Error::invalid(format!(
+            "{}: the file name has no extension, so its format is unknown; lumiere reads {SUPPORTED}",
+            path.display()
+        ))),
+        other => Err(Error::invalid(format!(
+            "{}: .{other} scenes are not supported; lumiere reads {SUPPORTED}",
+            path.display()
+        ))),
+    }
+}
