@@ -1,7 +1,8 @@
 //! Helpers shared by the integration tests: a seeded RNG and mesh generators.
 #![allow(dead_code)]
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
+use std::f32::consts::TAU;
 
 /// SplitMix64: tiny, seeded, good enough to generate test inputs reproducibly.
 pub struct TestRng(pub u64);
@@ -139,4 +140,28 @@ pub fn shared_scene(relative: &str) -> Option<std::path::PathBuf> {
     }
     eprintln!("skipped: needs ../shared/scenes/{relative}, which this clone does not have");
     None
+}
+
+/// Unwraps a chi-square result, printing the p-value (`--nocapture` shows them) or the report.
+pub fn assert_passes(name: &str, result: Result<f64, String>) {
+    match result {
+        Ok(p) => println!("{name}: p = {p:.4}"),
+        Err(report) => panic!("{name}: {report}"),
+    }
+}
+
+/// The azimuth of `w` as a fraction of a turn, computed independently of the warps' inverses.
+pub fn azimuth(w: Vec3) -> f32 {
+    (w.y.atan2(w.x) / TAU).rem_euclid(1.0)
+}
+
+/// A direction on the sphere as a point of the square: `((1 − cos θ)/2, φ/2π)`, `dω = 4π dx dy`.
+pub fn sphere_param(w: Vec3) -> Vec2 {
+    Vec2::new(0.5 * (1.0 - w.z), azimuth(w))
+}
+
+/// A direction on the upper hemisphere as a point of the square: `(cos θ, φ/2π)`, `dω = 2π dx dy`.
+/// Directions below the horizon land outside the square, which the harness rejects.
+pub fn hemisphere_param(w: Vec3) -> Vec2 {
+    Vec2::new(w.z, azimuth(w))
 }

@@ -8,4 +8,5 @@ mod estimators;
 mod image_io;
 mod obj_loading;
 mod sampling;
+mod seams;
 mod triangle;

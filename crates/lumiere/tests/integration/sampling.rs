@@ -2,40 +2,15 @@
 //! (`lumiere::sampling::chi2`) and with deterministic properties: pdfs integrate to 1, inverses
 //! round-trip, frames are orthonormal, Sobol prefixes are stratified.
 
-use std::f32::consts::TAU;
 use std::f64::consts::PI;
 
-use crate::common::TestRng;
+use crate::common::{TestRng, assert_passes, hemisphere_param, sphere_param};
 use glam::{DVec3, Vec2, Vec3};
 use lumiere::math::Frame;
 use lumiere::sampler::{Sampler, SamplerKind};
 use lumiere::sampling::chi2::{Chi2Test, chi2_discrete, integrate_unit_square};
 use lumiere::sampling::distrib::AliasTable;
 use lumiere::sampling::warp::*;
-
-/// Unwraps a chi-square result, printing the p-value (`--nocapture` shows them) or the report.
-fn assert_passes(name: &str, result: Result<f64, String>) {
-    match result {
-        Ok(p) => println!("{name}: p = {p:.4}"),
-        Err(report) => panic!("{name}: {report}"),
-    }
-}
-
-/// The azimuth of `w` as a fraction of a turn, computed independently of the warps' inverses.
-fn azimuth(w: Vec3) -> f32 {
-    (w.y.atan2(w.x) / TAU).rem_euclid(1.0)
-}
-
-/// A direction on the sphere as a point of the square: `((1 − cos θ)/2, φ/2π)`, `dω = 4π dx dy`.
-fn sphere_param(w: Vec3) -> Vec2 {
-    Vec2::new(0.5 * (1.0 - w.z), azimuth(w))
-}
-
-/// A direction on the upper hemisphere as a point of the square: `(cos θ, φ/2π)`, `dω = 2π dx dy`.
-/// Directions below the horizon land outside the square, which the harness rejects.
-fn hemisphere_param(w: Vec3) -> Vec2 {
-    Vec2::new(w.z, azimuth(w))
-}
 
 /// Checks a direction warp's output is a unit vector before it is binned.
 fn unit(w: Vec3) -> Vec3 {

@@ -1,0 +1,294 @@
+//! The seams integrators are written against: the BSDF contract, light sampling, surface points
+//! and their spawned rays, the sample stream and scene construction. Each is checked for what the
+//! integrators rely on: pdfs that agree with the samples (chi-square), measures that match, rays
+//! that leave on the right side, numbers that depend only on (pixel, sample, dimension, seed).
+
+use std::f64::consts::PI;
+
+use crate::common::{TestRng, assert_passes, sphere_param};
+use glam::{Vec2, Vec3};
+use lumiere::accel::BuildPreset;
+use lumiere::lights::{LightSelection, LightSet};
+use lumiere::materials::{Bsdf, BsdfFlags, Lambert, Material};
+use lumiere::math::Ray;
+use lumiere::sampler::{SampleStream, Sampler, SamplerKind};
+use lumiere::sampling::chi2::{Chi2Test, chi2_discrete};
+use lumiere::scene::Scene;
+use lumiere::scene::mesh::TriangleMesh;
+use lumiere::world::World;
+
+/// The direction a sphere parameter `(x, y) = ((1 − cos θ)/2, φ/2π)` stands for.
+fn direction_of(p: Vec2) -> Vec3 {
+    let cos_theta = 1.0 - 2.0 * p.x as f64;
+    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    let phi = 2.0 * PI * p.y as f64;
+    Vec3::new((sin_theta * phi.cos()) as f32, (sin_theta * phi.sin()) as f32, cos_theta as f32)
+}
+
+// ---------------------------------------------------------------------------------------------
+// BSDF contract
+
+/// Lambert's `sample` draws directions with the density its `pdf` claims, over the whole sphere
+/// (so directions below the surface would show as cells observed but never expected).
+#[test]
+fn lambert_samples_follow_its_pdf_over_the_sphere() {
+    let bsdf = Lambert { reflectance: Vec3::new(0.8, 0.5, 0.2) };
+    for (i, wo) in [Vec3::Z, Vec3::new(0.6, 0.0, 0.8), Vec3::new(-0.3, 0.9, 0.1).normalize()].into_iter().enumerate() {
+        let result = Chi2Test::new(32, 64).run_warp(
+            500_000,
+            10 + i as u64,
+            |u| bsdf.sample(wo, u).map(|s| sphere_param(s.wi)),
+            |p| 4.0 * PI * bsdf.pdf(wo, direction_of(p)) as f64,
+        );
+        assert_passes(&format!("Lambert, wo {wo}"), result);
+    }
+}
+
+/// A sample carries exactly `eval` and `pdf` of its own direction, and `f cos / pdf` is the albedo:
+/// Lambert neither creates nor loses energy (a white furnace in one line).
+#[test]
+fn lambert_samples_agree_with_eval_and_pdf_and_conserve_energy() {
+    let bsdf = Lambert { reflectance: Vec3::new(0.8, 0.5, 0.2) };
+    let mut rng = TestRng(3);
+    for _ in 0..10_000 {
+        let wo = rng.direction();
+        let u = Vec2::new(rng.f32(), rng.f32());
+        let Some(s) = bsdf.sample(wo, u) else {
+            assert!(wo.z <= 0.0, "no sample for wo {wo} above the surface");
+            continue;
+        };
+        assert_eq!(s.f, bsdf.eval(wo, s.wi));
+        assert_eq!(s.pdf, bsdf.pdf(wo, s.wi));
+        assert!(s.flags.contains(BsdfFlags::REFLECTION | BsdfFlags::DIFFUSE));
+        assert!(!s.flags.contains(BsdfFlags::SPECULAR));
+        let weight = s.f * s.wi.z / s.pdf;
+        assert!((weight - bsdf.albedo()).abs().max_element() < 1e-5, "f cos / pdf = {weight}");
+    }
+    // Reciprocity, and nothing below the surface.
+    for _ in 0..1000 {
+        let (a, b) = (rng.direction(), rng.direction());
+        assert_eq!(bsdf.eval(a, b), bsdf.eval(b, a));
+        if a.z <= 0.0 || b.z <= 0.0 {
+            assert_eq!((bsdf.eval(a, b), bsdf.pdf(a, b)), (Vec3::ZERO, 0.0));
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Lights
+
+/// A floor and two emitting triangles of different power facing down onto it, and one facing up.
+fn light_scene() -> Scene {
+    let positions = vec![
+        // floor
+        Vec3::new(-5.0, 0.0, -5.0),
+        Vec3::new(5.0, 0.0, -5.0),
+        Vec3::new(0.0, 0.0, 5.0),
+        // a dim light, facing down (winding seen from below is counter-clockwise)
+        Vec3::new(-1.0, 2.0, -1.0),
+        Vec3::new(1.0, 2.0, -1.0),
+        Vec3::new(0.0, 2.0, 1.0),
+        // a bright light, smaller and higher, facing down
+        Vec3::new(-0.5, 3.0, 0.0),
+        Vec3::new(0.5, 3.0, 0.0),
+        Vec3::new(0.0, 3.5, 0.5),
+    ];
+    let mesh = TriangleMesh {
+        positions,
+        indices: vec![[0, 2, 1], [3, 4, 5], [6, 7, 8]],
+        material_ids: vec![0, 1, 2],
+        ..Default::default()
+    };
+    let light = |name: &str, ke: f32| Material { ke: Vec3::splat(ke), ..Material::default_grey(name) };
+    let materials = vec![Material::default_grey("floor"), light("dim", 2.0), light("bright", 50.0)];
+    Scene::from_parts("lights".into(), mesh, materials, vec![]).unwrap()
+}
+
+#[test]
+fn the_triangle_to_light_map_names_each_emitter() {
+    let lights = LightSet::new(&light_scene());
+    assert_eq!(lights.lights().len(), 2);
+    assert_eq!(
+        (lights.light_of(0), lights.light_of(1), lights.light_of(2), lights.light_of(3)),
+        (None, Some(0), Some(1), None)
+    );
+}
+
+/// Light choice by power and uniformly: observed frequencies match `choice_pmf`.
+#[test]
+fn light_choice_frequencies_match_their_pmf() {
+    let lights = LightSet::new(&light_scene());
+    let mut rng = TestRng(5);
+    for selection in [LightSelection::Uniform, LightSelection::Power] {
+        let mut counts = [0u64; 2];
+        for _ in 0..200_000 {
+            let (index, pmf) = lights.choose(selection, rng.f32()).unwrap();
+            assert_eq!(pmf, lights.choice_pmf(selection, index));
+            counts[index as usize] += 1;
+        }
+        let pmf = [0, 1].map(|i| lights.choice_pmf(selection, i) as f64);
+        assert!((pmf.iter().sum::<f64>() - 1.0).abs() < 1e-6);
+        let p = chi2_discrete(&pmf, &counts).unwrap_or_else(|e| panic!("{selection:?}: {e}"));
+        println!("{selection:?}: p = {p:.4}");
+    }
+}
+
+/// The solid angle of triangle `[a, b, c]` seen from `p` (Van Oosterom and Strackee 1983).
+fn solid_angle(p: Vec3, [a, b, c]: [Vec3; 3]) -> f64 {
+    let (a, b, c) = ((a - p).as_dvec3(), (b - p).as_dvec3(), (c - p).as_dvec3());
+    let (la, lb, lc) = (a.length(), b.length(), c.length());
+    let numerator = a.dot(b.cross(c)).abs();
+    let denominator = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
+    2.0 * numerator.atan2(denominator)
+}
+
+/// Light samples carry their density per unit solid angle, light choice included: `E[1/pdf]` is
+/// the solid angle the lights subtend (in closed form), for either selection; and every sample's
+/// `pdf` equals `pdf_li` at its point.
+#[test]
+fn light_sample_pdfs_are_per_unit_solid_angle() {
+    let lights = LightSet::new(&light_scene());
+    let p = Vec3::new(0.2, 0.0, 0.1);
+    let expected: f64 = lights.lights().iter().map(|l| solid_angle(p, l.vertices)).sum();
+    for selection in [LightSelection::Uniform, LightSelection::Power] {
+        let mut rng = TestRng(7);
+        let n = 400_000;
+        let (mut sum, mut sum_sq) = (0.0f64, 0.0f64);
+        for _ in 0..n {
+            let u = Vec2::new(rng.f32(), rng.f32());
+            let s = lights.sample_li(selection, p, rng.f32(), u).expect("both lights face p");
+            let on_light = pdf_at(&lights, selection, p, s.light, s.wi, s.dist);
+            assert!((s.pdf - on_light).abs() <= 1e-3 * on_light, "{selection:?}: pdf {} vs pdf_li {on_light}", s.pdf);
+            let w = 1.0 / s.pdf as f64;
+            sum += w;
+            sum_sq += w * w;
+        }
+        let mean = sum / n as f64;
+        let error = ((sum_sq / n as f64 - mean * mean) / n as f64).sqrt();
+        println!("{selection:?}: E[1/pdf] = {mean} +- {error}, solid angle {expected}");
+        assert!(
+            (mean - expected).abs() < 4.0 * error,
+            "{selection:?}: E[1/pdf] = {mean} +- {error}, expected {expected}"
+        );
+    }
+}
+
+/// `pdf_li` at the point a sample's direction and distance lead to.
+fn pdf_at(lights: &LightSet, selection: LightSelection, p: Vec3, light: u32, wi: Vec3, dist: f32) -> f32 {
+    lights.pdf_li(selection, p, light, p + wi * dist)
+}
+
+/// A light seen from behind gives no sample: emission is one-sided.
+#[test]
+fn lights_do_not_emit_backwards() {
+    let lights = LightSet::new(&light_scene());
+    let above = Vec3::new(0.0, 10.0, 0.0);
+    for k in 0..100 {
+        let u = Vec2::new(k as f32 / 100.0, 0.37);
+        assert!(lights.sample_li_on(0, above, u).is_none());
+        assert_eq!(lights.pdf_li(LightSelection::Uniform, above, 0, Vec3::new(0.0, 2.0, 0.0)), 0.0);
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Surface points
+
+/// Rays spawned from a hit point leave on the side they head to and never hit their own
+/// triangle, for directions on both sides, at every scale of coordinates.
+#[test]
+fn spawned_rays_leave_on_their_side_and_miss_their_own_triangle() {
+    let mut rng = TestRng(11);
+    for scale in [1e-3f32, 1.0, 1e3, 1e5] {
+        let corners = [rng.vec3(-1.0, 1.0), rng.vec3(-1.0, 1.0), rng.vec3(-1.0, 1.0)];
+        let mesh = TriangleMesh {
+            positions: corners.iter().map(|&c| c * scale).collect(),
+            indices: vec![[0, 1, 2]],
+            material_ids: vec![0],
+            ..Default::default()
+        };
+        let scene = Scene::from_parts("one".into(), mesh, vec![Material::default_grey("m")], vec![]).unwrap();
+        let world = World::new(scene, BuildPreset::Default);
+        let [a, b, c] = world.scene().mesh.vertices(0);
+        let centre = (a + b + c) / 3.0;
+        for _ in 0..2000 {
+            let eye = centre + rng.direction() * 3.0 * scale;
+            let ray = Ray::new(eye, (centre + (rng.vec3(-0.1, 0.1) * scale) - eye).normalize());
+            let Some(hit) = world.intersect(&ray) else { continue };
+            let surface = world.surface(&ray, &hit);
+            for dir in [rng.direction(), -rng.direction()] {
+                let spawned = surface.spawn_ray(dir);
+                let side = surface.ng.dot(spawned.origin - surface.p);
+                assert!(side * surface.ng.dot(dir) >= 0.0, "origin on the wrong side at scale {scale}");
+                assert!(world.intersect(&spawned).is_none(), "self-hit at scale {scale}");
+                let segment = surface.spawn_segment(surface.p + dir * scale);
+                assert!(!world.occluded(&segment), "segment self-hit at scale {scale}");
+            }
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Sample stream
+
+/// The stream takes one dimension per draw, in order, and camera sample `s` of a set of `n`
+/// points owns sampler indices `s·n .. s·n + n`: the numbers are a pure function of
+/// (pixel, sample, dimension, seed).
+#[test]
+fn the_sample_stream_numbers_dimensions_in_order() {
+    for kind in [SamplerKind::Independent, SamplerKind::Sobol] {
+        let sampler = Sampler::new(kind, 42);
+        let (pixel, sample) = (1234, 5);
+        let mut stream = SampleStream::new(&sampler, pixel, sample);
+        let first = stream.next_2d();
+        let set = stream.next_points(16);
+        let third = stream.next_1d();
+        assert_eq!(first, sampler.get_2d(pixel, sample, 0));
+        for k in 0..16 {
+            assert_eq!(set.get_2d(k), sampler.get_2d(pixel, sample * 16 + k, 1));
+            assert_eq!(set.get_1d(k), sampler.get_1d(pixel, sample * 16 + k, 1));
+        }
+        assert_eq!(third, sampler.get_1d(pixel, sample, 2));
+        let mut again = SampleStream::new(&sampler, pixel, sample);
+        assert_eq!(again.next_2d(), first, "a stream replays");
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Scenes
+
+#[test]
+fn scene_files_are_loaded_by_extension_or_refused_naming_it() {
+    let dir = crate::common::TempDir::new("seams-load");
+    let obj = dir.write("UPPER.OBJ", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    assert_eq!(Scene::load(&obj).unwrap().mesh.triangle_count(), 1);
+    for (name, expected) in [
+        ("model.ply", ".ply scenes are not supported"),
+        ("model.gltf", ".gltf scenes are not supported"),
+        ("noextension", "no extension"),
+    ] {
+        let path = dir.write(name, "v 0 0 0\n");
+        let message = Scene::load(&path).unwrap_err().to_string();
+        assert!(message.contains(expected) && message.contains(name), "{name}: {message}");
+        assert!(message.contains(".obj"), "the message names what is supported: {message}");
+    }
+}
+
+#[test]
+fn scenes_from_parts_refuse_parts_that_do_not_fit() {
+    let mesh = |indices: Vec<[u32; 3]>, material_ids: Vec<u32>| TriangleMesh {
+        positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+        indices,
+        material_ids,
+        ..Default::default()
+    };
+    let grey = || vec![Material::default_grey("m")];
+    assert!(Scene::from_parts("ok".into(), mesh(vec![[0, 1, 2]], vec![0]), grey(), vec![]).is_ok());
+    for (parts, expected) in [
+        (mesh(vec![[0, 1, 3]], vec![0]), "vertex index 3 out of range"),
+        (mesh(vec![[0, 1, 2]], vec![1]), "material id 1 out of range"),
+        (mesh(vec![[0, 1, 2]], vec![]), "1 triangles but 0 material ids"),
+    ] {
+        let message = Scene::from_parts("bad".into(), parts, grey(), vec![]).unwrap_err().to_string();
+        assert!(message.contains(expected), "{message}");
+    }
+}
