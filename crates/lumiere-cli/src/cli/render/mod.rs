@@ -1,0 +1,120 @@
+//! `lumiere render`: arguments → options → scene → world → passes → image file and statistics.
+
+mod camera;
+mod checkpointing;
+mod options;
+mod report;
+mod signals;
+
+use std::time::Instant;
+
+use lumiere::Result;
+use lumiere::accel::BuildPreset;
+use lumiere::image_io::{PngEncoding, check_output_path, write_image};
+use lumiere::render::film::Film;
+use lumiere::render::{Hooks, RenderOptions, RenderOutput, RenderStats, StopReason, render_progressive};
+use lumiere::scene::Scene;
+use lumiere::scene::camera::Camera;
+use lumiere::util::fs::check_writable;
+use lumiere::world::World;
+
+use super::args::RenderArgs;
+use checkpointing::Fingerprints;
+use report::Timings;
+
+/// Exit code of a render stopped by SIGINT or SIGTERM (its image of completed samples is written).
+pub const EXIT_INTERRUPTED: u8 = 3;
+
+/// Renders; returns the process exit code (0, or `EXIT_INTERRUPTED`).
+pub fn run(args: &RenderArgs) -> Result<u8> {
+    signals::install();
+    // Refuse bad output paths before spending minutes on a render.
+    check_output_path(&args.output)?;
+    for path in [&args.stats_json, &args.checkpoint].into_iter().flatten() {
+        check_writable(path)?;
+    }
+    let pool = super::pool(args.threads)?;
+    let threads = pool.current_num_threads();
+    pool.install(|| render(args, threads))
+}
+
+fn render(args: &RenderArgs, threads: usize) -> Result<u8> {
+    let load_start = Instant::now();
+    let scene = load_scene(args)?;
+    let load_ms = load_start.elapsed().as_secs_f64() * 1e3;
+    let camera = camera::from_args(args, &scene)?;
+    let options = options::from_args(args);
+    let fingerprints = Fingerprints::new(&scene, &options, &camera);
+    let (film, stats) = fingerprints.start(args.resume.as_deref(), &camera)?;
+
+    let build_start = Instant::now();
+    let world = World::new(scene, BuildPreset::Default);
+    let timings = Timings { load_ms, build_ms: build_start.elapsed().as_secs_f64() * 1e3 };
+
+    let output = render_passes(args, &world, &camera, &options, &fingerprints, film, stats)?;
+    write_image(&args.output, output.image.width, output.image.height, &output.image.pixels, png_encoding(args))?;
+    if let Some(path) = &args.checkpoint {
+        fingerprints.save(path, &output.film, &output.stats)?;
+    }
+    report::summary(&options, &camera, &output, threads, &args.output);
+    if let Some(path) = &args.stats_json {
+        report::stats_json(path, &world, &options, &camera, &output, threads, &timings)?;
+    }
+    Ok(if output.stop == StopReason::Interrupted { EXIT_INTERRUPTED } else { 0 })
+}
+
+/// The scene file or the built-in scene, with `--emission` applied and load warnings shown.
+fn load_scene(args: &RenderArgs) -> Result<Scene> {
+    let mut scene = match &args.scene {
+        Some(path) => Scene::load(path)?,
+        None => Scene::builtin()?,
+    };
+    for (name, ke) in &args.emission {
+        scene.set_emission(name, *ke)?;
+    }
+    for warning in &scene.warnings {
+        eprintln!("lumiere: warning: {warning}");
+    }
+    Ok(scene)
+}
+
+/// Runs the progressive passes with a progress bar, previews and checkpoints between passes, and
+/// the signal handler's cancel flag.
+fn render_passes(
+    args: &RenderArgs,
+    world: &World,
+    camera: &Camera,
+    options: &RenderOptions,
+    fingerprints: &Fingerprints,
+    film: Film,
+    stats: RenderStats,
+) -> Result<RenderOutput> {
+    let pixels = u64::from(camera.width) * u64::from(camera.height);
+    let bar = report::progress_bar(pixels * u64::from(options.spp), pixels * u64::from(film.samples));
+    let mut last_preview = Instant::now();
+    let mut last_checkpoint = Instant::now();
+    let mut pass_done = |film: &Film, stats: &RenderStats| -> Result<()> {
+        if let Some(every) = args.preview_every
+            && last_preview.elapsed().as_secs_f64() >= every
+        {
+            let image = film.image();
+            write_image(&args.output, image.width, image.height, &image.pixels, png_encoding(args))?;
+            last_preview = Instant::now();
+        }
+        if let Some(path) = &args.checkpoint
+            && last_checkpoint.elapsed().as_secs_f64() >= args.checkpoint_every
+        {
+            fingerprints.save(path, film, stats)?;
+            last_checkpoint = Instant::now();
+        }
+        Ok(())
+    };
+    let hooks = Hooks { progress: &|n| bar.inc(n), pass_done: &mut pass_done, cancel: &signals::CANCEL };
+    let output = render_progressive(world, camera, options, film, stats, hooks);
+    bar.finish_and_clear();
+    output
+}
+
+fn png_encoding(args: &RenderArgs) -> PngEncoding {
+    if args.png_linear { PngEncoding::GkitLinear } else { PngEncoding::Srgb }
+}

@@ -1,0 +1,102 @@
+//! What a render tells the user: a progress bar on a terminal, one closing line, and on request a
+//! JSON file of statistics.
+
+use std::io::IsTerminal;
+use std::path::Path;
+
+use indicatif::{ProgressBar, ProgressStyle};
+
+use lumiere::integrators::{AmbientOcclusion, Direct, Technique};
+use lumiere::render::{RenderOptions, RenderOutput};
+use lumiere::scene::camera::Camera;
+use lumiere::util::fs::write_atomically;
+use lumiere::world::World;
+use lumiere::{Error, Result};
+
+/// Milliseconds spent before rendering.
+pub struct Timings {
+    pub load_ms: f64,
+    pub build_ms: f64,
+}
+
+/// A bar of pixel samples (`done` of `total`) with an ETA, on stderr when it is a terminal.
+pub fn progress_bar(total: u64, done: u64) -> ProgressBar {
+    if !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(total);
+    bar.set_position(done);
+    if let Ok(style) = ProgressStyle::with_template("{spinner} [{elapsed_precise}] {wide_bar} {percent}% ETA {eta}") {
+        bar.set_style(style);
+    }
+    bar
+}
+
+/// The closing line: what was rendered, why it stopped, time, rays and speed, where it went.
+pub fn summary(options: &RenderOptions, camera: &Camera, output: &RenderOutput, threads: usize, path: &Path) {
+    let noise = output.film.relative_error().map_or(String::new(), |e| format!(", relative error {e:.4}"));
+    eprintln!(
+        "lumiere: {} {}x{}: {} after {} of {} spp{noise}; {:.1} ms ({threads} threads), {} rays, {:.1} Mrays/s -> {}",
+        options.technique.name(),
+        camera.width,
+        camera.height,
+        output.stop.describe(),
+        output.film.samples,
+        options.spp,
+        output.stats.elapsed.as_secs_f64() * 1e3,
+        output.stats.rays,
+        output.stats.mrays_per_second(),
+        path.display()
+    );
+    if output.film.discarded > 0 {
+        eprintln!("lumiere: warning: {} non-finite or negative samples were discarded", output.film.discarded);
+    }
+}
+
+/// Writes the statistics of a render as JSON, atomically.
+pub fn stats_json(
+    path: &Path,
+    world: &World,
+    options: &RenderOptions,
+    camera: &Camera,
+    output: &RenderOutput,
+    threads: usize,
+    timings: &Timings,
+) -> Result<()> {
+    let stats = serde_json::json!({
+        "scene": world.scene().name,
+        "mode": options.technique.name(),
+        "technique": format!("{:?}", options.technique),
+        "samples": samples_per_camera_sample(&options.technique),
+        "width": camera.width,
+        "height": camera.height,
+        "spp": output.film.samples,
+        "spp_requested": options.spp,
+        "sampler": format!("{:?}", options.sampler).to_lowercase(),
+        "seed": options.seed,
+        "threads": threads,
+        "triangles": world.scene().mesh.triangle_count(),
+        "lights": world.lights().lights().len(),
+        "bvh_nodes": world.bvh().nodes().len(),
+        "load_ms": timings.load_ms,
+        "build_ms": timings.build_ms,
+        "render_ms": output.stats.elapsed.as_secs_f64() * 1e3,
+        "rays": output.stats.rays,
+        "mrays_per_s": output.stats.mrays_per_second(),
+        "stop": output.stop.describe(),
+        "relative_error": output.film.relative_error(),
+        "discarded_samples": output.film.discarded,
+    });
+    let text = serde_json::to_string_pretty(&stats).map_err(|e| Error::invalid(format!("stats: {e}")))?;
+    write_atomically(path, format!("{text}\n").as_bytes())
+}
+
+/// `--samples` where the technique has it (null in the JSON otherwise).
+fn samples_per_camera_sample(technique: &Technique) -> Option<u32> {
+    match technique {
+        Technique::Direct(Direct { samples, .. }) | Technique::AmbientOcclusion(AmbientOcclusion { samples, .. }) => {
+            Some(*samples)
+        }
+        _ => None,
+    }
+}

@@ -1,0 +1,23 @@
+//! SIGINT and SIGTERM: the first one stops the render cleanly (the image of every completed sample
+//! and the checkpoint are written, exit code 3); a second one quits at once. Files are written
+//! atomically, so neither leaves a half-written file.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Set by the first signal; the render loop watches it.
+pub static CANCEL: AtomicBool = AtomicBool::new(false);
+
+/// Exit code after a second signal (128 + SIGINT, as a shell reports it).
+const EXIT_AT_ONCE: i32 = 130;
+
+/// Installs the handler. A failure only costs a warning: the render still runs, but an interruption
+/// will lose it.
+pub fn install() {
+    if let Err(e) = ctrlc::set_handler(|| {
+        if CANCEL.swap(true, Ordering::SeqCst) {
+            std::process::exit(EXIT_AT_ONCE);
+        }
+    }) {
+        eprintln!("lumiere: warning: cannot catch Ctrl-C ({e}); an interruption will lose the render");
+    }
+}
