@@ -6,6 +6,7 @@ mod bvh;
 mod camera;
 mod estimators;
 mod image_io;
+mod module_graph;
 mod obj_loading;
 mod sampling;
 mod seams;
