@@ -12,7 +12,7 @@ use glam::Vec3;
 use image::{ExtendedColorType, ImageEncoder};
 
 use crate::error::{Error, Result};
-use crate::util::fs::{check_writable, write_atomically};
+use crate::util::write::{check_writable, write_atomically};
 
 /// How a PNG stores linear radiance.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]

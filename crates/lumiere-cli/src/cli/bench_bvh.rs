@@ -6,7 +6,7 @@ use crate::bench::bvh::{build, median_seconds, mesh_bytes, mismatches, peak_rss_
 use crate::bench::rays::make_ray_sets;
 use crate::bench::scenes::BenchScene;
 use lumiere::accel::{BuildPreset, Bvh};
-use lumiere::util::fs::write_atomically;
+use lumiere::util::write::write_atomically;
 use lumiere::world::World;
 use lumiere::{Error, Result};
 

@@ -6,7 +6,7 @@ use lumiere::integrators::{AmbientOcclusion, Direct, LightSampling, Shadows, Tec
 use lumiere::render::{RenderOptions, render};
 use lumiere::scene::camera::Camera;
 use lumiere::scene::{Scene, builtin};
-use lumiere::util::fs::write_atomically;
+use lumiere::util::write::write_atomically;
 use lumiere::world::World;
 use lumiere::{Error, Result};
 

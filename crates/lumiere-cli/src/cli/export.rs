@@ -9,7 +9,7 @@ use std::path::Path;
 
 use crate::bench::rays::{Query, RaySet};
 use lumiere::scene::mesh::TriangleMesh;
-use lumiere::util::fs::write_atomically;
+use lumiere::util::write::write_atomically;
 use lumiere::world::World;
 use lumiere::{Error, Result};
 

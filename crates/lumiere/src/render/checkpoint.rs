@@ -12,8 +12,8 @@ use std::time::Duration;
 use crate::error::{Error, Result};
 use crate::render::RenderStats;
 use crate::render::film::Film;
-use crate::util::fs::write_atomically;
 use crate::util::hash::hash_bytes;
+use crate::util::write::write_atomically;
 
 const MAGIC: &[u8; 8] = b"LUMCKPT1";
 const VERSION: u32 = 1;

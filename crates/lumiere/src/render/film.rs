@@ -103,7 +103,7 @@ impl Film {
 fn check_memory(width: u32, height: u32) -> Result<()> {
     // In u128: width * height * bytes overflows u64 for the largest u32 sizes.
     let needed = width as u128 * height as u128 * BYTES_PER_PIXEL as u128;
-    let available = crate::util::fs::available_memory().unwrap_or(64 << 30);
+    let available = crate::util::read::available_memory().unwrap_or(64 << 30);
     if needed > available as u128 {
         return Err(Error::invalid(format!(
             "image size {width}x{height} needs {:.1} GiB of memory to render; {:.1} GiB is available",

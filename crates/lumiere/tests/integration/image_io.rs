@@ -8,7 +8,7 @@ use crate::common::TempDir;
 use glam::Vec3;
 use lumiere::Error;
 use lumiere::image_io::{PngEncoding, check_output_path, linear_to_srgb8, write_image};
-use lumiere::util::fs::write_atomically;
+use lumiere::util::write::write_atomically;
 
 /// The reference: IEC 61966-2-1 in f64, rounded to nearest.
 fn srgb8_exact(c: f32) -> u8 {

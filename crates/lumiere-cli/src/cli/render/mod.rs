@@ -15,7 +15,7 @@ use lumiere::render::film::Film;
 use lumiere::render::{Hooks, RenderOptions, RenderOutput, RenderStats, StopReason, render_progressive};
 use lumiere::scene::Scene;
 use lumiere::scene::camera::Camera;
-use lumiere::util::fs::check_writable;
+use lumiere::util::write::check_writable;
 use lumiere::world::World;
 
 use super::args::RenderArgs;

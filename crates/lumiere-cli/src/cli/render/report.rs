@@ -9,7 +9,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use lumiere::integrators::{AmbientOcclusion, Direct, Technique};
 use lumiere::render::{RenderOptions, RenderOutput};
 use lumiere::scene::camera::Camera;
-use lumiere::util::fs::write_atomically;
+use lumiere::util::write::write_atomically;
 use lumiere::world::World;
 use lumiere::{Error, Result};
 

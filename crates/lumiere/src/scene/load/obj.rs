@@ -17,7 +17,7 @@ use crate::error::{Error, Result};
 use crate::materials::Material;
 use crate::scene::Scene;
 use crate::scene::mesh::{NO_INDEX, TriangleMesh};
-use crate::util::fs;
+use crate::util::read;
 use chunk::{ChunkCounts, ChunkMesh, ChunkStart, VertexCounts, parse_chunk};
 use materials::{MaterialTable, ReadMtl};
 use rayon::prelude::*;
@@ -46,11 +46,11 @@ impl ObjScene {
 
 /// Loads `path` (`.obj` or `.obj.gz`); `mtllib` files resolve relative to the OBJ's folder.
 pub fn load_obj(path: &Path) -> Result<ObjScene> {
-    let bytes = fs::read_input(path).map_err(|error| Error::io(path, error))?;
+    let bytes = read::read_input(path).map_err(|error| Error::io(path, error))?;
     let folder = path.parent().unwrap_or(Path::new(""));
     let read_mtl = |name: &str| {
         let mtl = folder.join(name);
-        match fs::read_input(&mtl) {
+        match read::read_input(&mtl) {
             Ok(bytes) => Ok((bytes, mtl)),
             // The OBJ only knows the name; the warning should say where we looked.
             Err(error) => Err(io::Error::new(error.kind(), format!("{}: {error}", mtl.display()))),
