@@ -11,6 +11,7 @@ use lumiere::world::World;
 use lumiere::{Error, Result};
 
 use super::args::BenchLabArgs;
+use super::output;
 use super::pool;
 
 /// One row of the lab's table: what was rendered and the lab's serial and parallel milliseconds.
@@ -75,10 +76,10 @@ pub fn run(args: &BenchLabArgs) -> Result<()> {
     let serial = pool(1)?;
     let parallel = pool(all_cores)?;
 
-    println!(
+    output::print(format_args!(
         "| image ({width}x{height}) | lab serial ms | serial ms | speed-up | lab parallel ms | parallel ms ({all_cores} threads) | speed-up | rays | Mrays/s (parallel) |"
-    );
-    println!("|---|---|---|---|---|---|---|---|---|");
+    ))?;
+    output::print(format_args!("|---|---|---|---|---|---|---|---|---|"))?;
     let mut json = Vec::new();
     for row in &LAB_ROWS {
         let options = RenderOptions::new(row.technique);
@@ -96,14 +97,14 @@ pub fn run(args: &BenchLabArgs) -> Result<()> {
         let serial_ms = time(&serial)?;
         let parallel_ms = time(&parallel)?;
         let mrays = rays as f64 / parallel_ms / 1e3;
-        println!(
+        output::print(format_args!(
             "| {} | {:.0} | {serial_ms:.0} | {:.1}x | {:.0} | {parallel_ms:.0} | {:.1}x | {rays} | {mrays:.1} |",
             row.label,
             row.lab_serial_ms,
             row.lab_serial_ms / serial_ms,
             row.lab_parallel_ms,
             row.lab_parallel_ms / parallel_ms
-        );
+        ))?;
         json.push(serde_json::json!({
             "image": row.label, "mode": row.technique.name(), "technique": format!("{:?}", row.technique), "width": width, "height": height,
             "repeats": repeats, "lab_serial_ms": row.lab_serial_ms, "serial_ms": serial_ms,
@@ -112,7 +113,9 @@ pub fn run(args: &BenchLabArgs) -> Result<()> {
         }));
     }
     if args.quick {
-        println!("\n(--quick: {width}x{height}, one run per row; the lab's figures are for 1024x768.)");
+        output::print(format_args!(
+            "\n(--quick: {width}x{height}, one run per row; the lab's figures are for 1024x768.)"
+        ))?;
     }
     if let Some(path) = &args.json {
         let text = serde_json::to_string_pretty(&json).map_err(|e| Error::invalid(format!("json: {e}")))?;

@@ -11,6 +11,7 @@ use lumiere::scene::{Scene, builtin};
 use lumiere::world::World;
 
 use super::args::BenchSamplerArgs;
+use super::output;
 
 pub fn run(args: &BenchSamplerArgs) -> Result<()> {
     let (width, height) = args.size;
@@ -20,11 +21,11 @@ pub fn run(args: &BenchSamplerArgs) -> Result<()> {
         let options = RenderOptions { sampler, seed, ..RenderOptions::new(technique(samples)) };
         Ok(render(&world, &camera, &options, &|_| {})?.image)
     };
-    println!(
+    output::print(format_args!(
         "| image ({width}x{height}) | N | independent RMSE | Sobol RMSE | Sobol / independent | (reference: Sobol, N={}, seed 1000) |",
         args.reference_samples
-    );
-    println!("|---|---|---|---|---|---|");
+    ))?;
+    output::print(format_args!("|---|---|---|---|---|---|"))?;
     for (label, mode) in
         [("soft shadows", Technique::direct as fn(u32) -> Technique), ("AO", Technique::ambient_occlusion)]
     {
@@ -39,7 +40,10 @@ pub fn run(args: &BenchSamplerArgs) -> Result<()> {
                 Ok(sum / args.seeds as f64)
             };
             let (independent, sobol) = (error(SamplerKind::Independent)?, error(SamplerKind::Sobol)?);
-            println!("| {label} | {n} | {independent:.5} | {sobol:.5} | {:.2} | |", sobol / independent);
+            output::print(format_args!(
+                "| {label} | {n} | {independent:.5} | {sobol:.5} | {:.2} | |",
+                sobol / independent
+            ))?;
         }
     }
     Ok(())

@@ -7,38 +7,39 @@ use lumiere::lights::LightSet;
 use lumiere::scene::Scene;
 
 use super::args::InfoArgs;
+use super::output;
 
 pub fn run(args: &InfoArgs) -> Result<()> {
     let start = Instant::now();
     let scene = Scene::load(&args.scene)?;
     let load_ms = start.elapsed().as_secs_f64() * 1e3;
     for warning in &scene.warnings {
-        eprintln!("lumiere: warning: {warning}");
+        output::warn(format_args!("{warning}"));
     }
     let bounds = scene.bounds();
     let lights = LightSet::new(&scene);
     let lights = lights.lights();
     let light_area: f32 = lights.iter().map(|l| l.area).sum();
     let light_power: Vec3 = lights.iter().map(|l| l.power()).sum();
-    println!("scene      {}", scene.name);
-    println!("triangles  {}", scene.mesh.triangle_count());
-    println!("vertices   {}", scene.mesh.positions.len());
-    println!("materials  {}", scene.materials.len());
-    println!(
+    output::print(format_args!("scene      {}", scene.name))?;
+    output::print(format_args!("triangles  {}", scene.mesh.triangle_count()))?;
+    output::print(format_args!("vertices   {}", scene.mesh.positions.len()))?;
+    output::print(format_args!("materials  {}", scene.materials.len()))?;
+    output::print(format_args!(
         "lights     {} triangles, area {light_area:.6}, power {:.6} {:.6} {:.6} W",
         lights.len(),
         light_power.x,
         light_power.y,
         light_power.z
-    );
+    ))?;
     if bounds.is_empty() {
-        println!("bounds     empty");
+        output::print(format_args!("bounds     empty"))?;
     } else {
-        println!(
+        output::print(format_args!(
             "bounds     ({:.6}, {:.6}, {:.6}) .. ({:.6}, {:.6}, {:.6})",
             bounds.min.x, bounds.min.y, bounds.min.z, bounds.max.x, bounds.max.y, bounds.max.z
-        );
+        ))?;
     }
-    println!("load       {load_ms:.1} ms");
+    output::print(format_args!("load       {load_ms:.1} ms"))?;
     Ok(())
 }

@@ -136,74 +136,89 @@ fn run_passes<I: Integrator>(
     let before = stats.elapsed;
     let sampler = Sampler::new(options.sampler, options.seed);
     let tiles = tiles(camera.width, camera.height);
+    let deadline = options.time_budget.map(|budget| start + budget);
+    // Checked between passes and inside every tile, so that a costly pixel (thousands of samples,
+    // thousands of lights) neither outlives the budget nor ignores Ctrl-C for more than a row.
+    let stop_now = || {
+        if hooks.cancel.load(Ordering::Relaxed) {
+            Some(StopReason::Interrupted)
+        } else if deadline.is_some_and(|d| Instant::now() >= d) {
+            Some(StopReason::TimeBudget)
+        } else {
+            None
+        }
+    };
+    let pixel_centre = options.samples_pixel_centres();
     let stop = loop {
         if film.samples >= options.spp {
             break StopReason::Completed;
         }
-        let Some(pass) = render_pass(integrator, world, camera, &sampler, &tiles, film.samples, options.spp, &hooks)
-        else {
-            break StopReason::Interrupted;
+        if let Some(reason) = stop_now() {
+            break reason;
+        }
+        let pass = Pass { sampler: &sampler, sample: film.samples, pixel_centre };
+        let Some(tile_values) = render_pass(integrator, world, camera, &pass, &tiles, hooks.progress, &stop_now) else {
+            // The pass in flight is abandoned: the film keeps whole passes only.
+            break stop_now().unwrap_or(StopReason::Interrupted);
         };
-        for (tile, (values, rays)) in tiles.iter().zip(pass) {
+        for (tile, (values, rays)) in tiles.iter().zip(tile_values) {
             film.add_tile(tile.x0, tile.y0, tile.x1 - tile.x0, &values);
             stats.rays += rays;
         }
         film.samples += 1;
         stats.elapsed = before + start.elapsed();
         (hooks.pass_done)(&film, &stats)?;
-        if film.samples >= options.spp {
-            break StopReason::Completed;
-        }
-        if options.time_budget.is_some_and(|budget| start.elapsed() >= budget) {
-            break StopReason::TimeBudget;
-        }
         if let (Some(target), Some(error)) = (options.noise_target, film.relative_error())
             && error <= target
         {
             break StopReason::NoiseTarget;
-        }
-        if hooks.cancel.load(Ordering::Relaxed) {
-            break StopReason::Interrupted;
         }
     };
     stats.elapsed = before + start.elapsed();
     Ok(RenderOutput { image: film.image(), film, stats, stop })
 }
 
-/// One sample per pixel (sample index `sample`): per tile, its values row by row and its rays;
-/// `None` if cancelled before the pass completed.
-#[expect(clippy::too_many_arguments, reason = "the pass's whole context, passed once per pass")]
+/// What every pixel of one pass shares.
+struct Pass<'a> {
+    sampler: &'a Sampler,
+    /// The camera sample index of this pass.
+    sample: u32,
+    /// Sample pixel centres (the lab's single ray) rather than jittered positions.
+    pixel_centre: bool,
+}
+
+/// One sample per pixel: per tile, its values row by row and its rays; `None` as soon as
+/// `stop_now` says so (checked before every row of every tile).
 fn render_pass<I: Integrator>(
     integrator: &I,
     world: &World,
     camera: &Camera,
-    sampler: &Sampler,
+    pass: &Pass,
     tiles: &[Tile],
-    sample: u32,
-    spp: u32,
-    hooks: &Hooks,
+    progress: &(dyn Fn(u64) + Sync),
+    stop_now: &(dyn Fn() -> Option<StopReason> + Sync),
 ) -> Option<Vec<(Vec<Vec3>, u64)>> {
     tiles
         .par_iter()
         .map(|tile| {
-            if hooks.cancel.load(Ordering::Relaxed) {
-                return None;
-            }
-            let mut ctx =
-                SampleContext { stream: SampleStream::new(sampler, 0, sample), batch: OriginBatch::default(), rays: 0 };
+            let stream = SampleStream::new(pass.sampler, 0, pass.sample);
+            let mut ctx = SampleContext { stream, batch: OriginBatch::default(), rays: 0 };
             let mut values = Vec::with_capacity(((tile.x1 - tile.x0) * (tile.y1 - tile.y0)) as usize);
             for y in tile.y0..tile.y1 {
+                if stop_now().is_some() {
+                    return None;
+                }
                 for x in tile.x0..tile.x1 {
-                    ctx.stream = SampleStream::new(sampler, y * camera.width + x, sample);
-                    // The first dimension is the position in the pixel. One sample: the pixel centre, as
-                    // the lab did; more: jittered in the pixel.
+                    ctx.stream = SampleStream::new(pass.sampler, y * camera.width + x, pass.sample);
+                    // The first dimension is the position in the pixel, drawn even for pixel centres
+                    // so that the integrator's dimensions do not depend on it.
                     let jitter = ctx.stream.next_points(1);
-                    let offset = if spp == 1 { glam::Vec2::splat(0.5) } else { jitter.get_2d(0) };
+                    let offset = if pass.pixel_centre { glam::Vec2::splat(0.5) } else { jitter.get_2d(0) };
                     let ray = camera.ray(x as f32 + offset.x, y as f32 + offset.y);
                     values.push(integrator.radiance(world, &ray, &mut ctx));
                 }
             }
-            (hooks.progress)(values.len() as u64);
+            progress(values.len() as u64);
             Some((values, ctx.rays))
         })
         .collect()

@@ -35,6 +35,14 @@ impl RenderOptions {
         }
     }
 
+    /// Whether camera samples go through pixel centres (the lab's single ray, `spp == 1`) rather
+    /// than jittered positions. A render is one or the other from its first sample on: a render
+    /// of one sample per pixel cannot be continued with more (its checkpoint is refused), and a
+    /// render of several stopped after one pass holds a jittered sample, not the centre.
+    pub fn samples_pixel_centres(&self) -> bool {
+        self.spp == 1
+    }
+
     pub(super) fn validate(&self, camera: &Camera) -> Result<()> {
         if camera.width == 0 || camera.height == 0 {
             return Err(Error::invalid(format!("image size {}x{} has no pixels", camera.width, camera.height)));

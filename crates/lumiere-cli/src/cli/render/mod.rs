@@ -19,6 +19,7 @@ use lumiere::util::write::check_writable;
 use lumiere::world::World;
 
 use super::args::RenderArgs;
+use super::output;
 use checkpointing::Fingerprints;
 use report::Timings;
 
@@ -73,7 +74,7 @@ fn load_scene(args: &RenderArgs) -> Result<Scene> {
         scene.set_emission(name, *ke)?;
     }
     for warning in &scene.warnings {
-        eprintln!("lumiere: warning: {warning}");
+        output::warn(format_args!("{warning}"));
     }
     Ok(scene)
 }

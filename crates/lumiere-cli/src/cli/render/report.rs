@@ -13,6 +13,8 @@ use lumiere::util::write::write_atomically;
 use lumiere::world::World;
 use lumiere::{Error, Result};
 
+use crate::cli::output;
+
 /// Milliseconds spent before rendering.
 pub struct Timings {
     pub load_ms: f64,
@@ -35,7 +37,7 @@ pub fn progress_bar(total: u64, done: u64) -> ProgressBar {
 /// The closing line: what was rendered, why it stopped, time, rays and speed, where it went.
 pub fn summary(options: &RenderOptions, camera: &Camera, output: &RenderOutput, threads: usize, path: &Path) {
     let noise = output.film.relative_error().map_or(String::new(), |e| format!(", relative error {e:.4}"));
-    eprintln!(
+    output::note(format_args!(
         "lumiere: {} {}x{}: {} after {} of {} spp{noise}; {:.1} ms ({threads} threads), {} rays, {:.1} Mrays/s -> {}",
         options.technique.name(),
         camera.width,
@@ -47,9 +49,9 @@ pub fn summary(options: &RenderOptions, camera: &Camera, output: &RenderOutput, 
         output.stats.rays,
         output.stats.mrays_per_second(),
         path.display()
-    );
+    ));
     if output.film.discarded > 0 {
-        eprintln!("lumiere: warning: {} non-finite or negative samples were discarded", output.film.discarded);
+        output::warn(format_args!("{} non-finite or negative samples were discarded", output.film.discarded));
     }
 }
 

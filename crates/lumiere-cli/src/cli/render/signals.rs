@@ -4,6 +4,8 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
+use crate::cli::output;
+
 /// Set by the first signal; the render loop watches it.
 pub static CANCEL: AtomicBool = AtomicBool::new(false);
 
@@ -18,6 +20,6 @@ pub fn install() {
             std::process::exit(EXIT_AT_ONCE);
         }
     }) {
-        eprintln!("lumiere: warning: cannot catch Ctrl-C ({e}); an interruption will lose the render");
+        output::warn(format_args!("cannot catch Ctrl-C ({e}); an interruption will lose the render"));
     }
 }
