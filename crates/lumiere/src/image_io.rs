@@ -144,7 +144,14 @@ fn format_of(path: &Path) -> Result<Format> {
         Some("png") => Ok(Format::Png),
         Some("exr") => Ok(Format::Exr),
         Some("pfm") => Ok(Format::Pfm),
-        _ => Err(Error::invalid(format!("{}: unsupported image extension (supported: {SUPPORTED})", path.display()))),
+        Some(other) => Err(Error::invalid(format!(
+            "{}: .{other} is not an image format lumiere writes (supported: {SUPPORTED})",
+            path.display()
+        ))),
+        None => Err(Error::invalid(format!(
+            "{}: the file name has no extension, so the image format is unknown (supported: {SUPPORTED})",
+            path.display()
+        ))),
     }
 }
 

@@ -131,25 +131,29 @@ pub struct RenderArgs {
     #[arg(long, value_enum, default_value_t = ModeArg::Shadows)]
     pub mode: ModeArg,
 
-    /// Samples per light triangle (direct), in total (direct with power light sampling) or per
-    /// hemisphere (ao).
-    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..))]
-    pub samples: u32,
+    /// Samples per camera sample, for direct and ao only: points on every light triangle (direct),
+    /// points in total (direct with --light-sampling power), or directions (ao). A pixel traces
+    /// samples x spp rays. [default: 16]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    pub samples: Option<u32>,
 
-    /// Camera samples per pixel; 1 is one ray through the pixel centre, more are jittered in the pixel.
-    #[arg(long, default_value_t = 1)]
-    pub spp: u32,
+    /// Camera samples per pixel, each a pass over the image: 1 is one ray through each pixel centre
+    /// (the lab's images), more are jittered in the pixel. [default: 1, or unlimited with --time
+    /// or --noise: the render goes on until the budget is met]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    pub spp: Option<u32>,
 
     /// Random number generator for the Monte Carlo modes.
     #[arg(long, value_enum, default_value_t = SamplerArg::Independent)]
     pub sampler: SamplerArg,
 
     /// How direct lighting chooses its light samples.
-    #[arg(long, value_enum, default_value_t = LightSamplingArg::PerLight)]
-    pub light_sampling: LightSamplingArg,
+    /// [default: per-light; direct only]
+    #[arg(long, value_enum)]
+    pub light_sampling: Option<LightSamplingArg>,
 
-    /// Ambient occlusion rays stop at this distance (default: infinite, visibility of the sky).
-    #[arg(long)]
+    /// Ambient occlusion rays stop at this distance (default: infinite, visibility of the sky; ao only).
+    #[arg(long, value_parser = parse_positive_f32, allow_hyphen_values = true)]
     pub ao_distance: Option<f32>,
 
     /// Set the emission Ke of a material, NAME=r,g,b (repeatable); e.g. Emission=5,5,5 on the staircase.
@@ -176,12 +180,13 @@ pub struct RenderArgs {
     #[arg(long, value_parser = parse_vec3, default_value = "0,1,0", allow_hyphen_values = true)]
     pub up: Vec3,
 
-    /// Vertical field of view of the look-at camera, degrees.
-    #[arg(long, default_value_t = 45.0)]
-    pub fov: f32,
+    /// Vertical field of view of the look-at camera, in degrees, between 0 and 180 (exclusive);
+    /// orbiter cameras use gKit's 45. [default: 45]
+    #[arg(long, value_parser = parse_fov, allow_hyphen_values = true)]
+    pub fov: Option<f32>,
 
-    /// Worker threads; 0 = one per core, 1 = serial.
-    #[arg(long, default_value_t = 0)]
+    /// Worker threads, at most 1024; 0 = one per core, 1 = serial.
+    #[arg(long, default_value_t = 0, value_parser = parse_threads)]
     pub threads: usize,
 
     /// Seed of the random numbers; the same seed gives the same image bytes for any thread count.
@@ -201,15 +206,15 @@ pub struct RenderArgs {
     pub stats_json: Option<PathBuf>,
 
     /// Stop after the pass that crosses this rendering time (e.g. 30s, 5m, 1h, 1.5s).
-    #[arg(long, value_parser = parse_duration)]
+    #[arg(long, value_parser = parse_duration, allow_hyphen_values = true)]
     pub time: Option<std::time::Duration>,
 
     /// Stop once the estimated relative standard error of the image is below this (e.g. 0.01).
-    #[arg(long)]
+    #[arg(long, value_parser = parse_positive_f64, allow_hyphen_values = true)]
     pub noise: Option<f64>,
 
-    /// Rewrite the output image with the current estimate every SECONDS (atomically).
-    #[arg(long)]
+    /// Rewrite the output image with the current estimate every SECONDS (atomically), between passes.
+    #[arg(long, value_parser = parse_positive_f64, allow_hyphen_values = true)]
     pub preview_every: Option<f64>,
 
     /// Save the accumulation state to this file after passes (atomically), for --resume.
@@ -217,7 +222,7 @@ pub struct RenderArgs {
     pub checkpoint: Option<PathBuf>,
 
     /// Seconds between checkpoints; 0 saves after every pass.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, value_parser = parse_non_negative_f64, allow_hyphen_values = true)]
     pub checkpoint_every: f64,
 
     /// Continue the render saved in this checkpoint (same scene and options; --spp may grow).
@@ -236,17 +241,57 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
 }
 
 fn parse_duration(s: &str) -> Result<std::time::Duration, String> {
-    let s = s.trim();
-    let (number, unit) = s.split_at(s.find(|c: char| c.is_ascii_alphabetic()).unwrap_or(s.len()));
-    let value: f64 = number.trim().parse().map_err(|_| format!("expected a duration like 30s, 5m or 1h, got '{s}'"))?;
-    let seconds = match unit {
-        "" | "s" => value,
-        "ms" => value / 1e3,
-        "m" | "min" => value * 60.0,
-        "h" => value * 3600.0,
-        _ => return Err(format!("unknown time unit '{unit}' (use ms, s, m or h)")),
-    };
-    std::time::Duration::try_from_secs_f64(seconds).map_err(|_| format!("'{s}' is not a valid duration"))
+    let text = s.trim();
+    // The unit is a suffix, so that exponents parse: 1e3s, 2.5e-1h.
+    let units: [(&str, f64); 5] = [("ms", 1e-3), ("min", 60.0), ("s", 1.0), ("m", 60.0), ("h", 3600.0)];
+    let (number, scale) =
+        units.iter().find_map(|&(unit, scale)| Some((text.strip_suffix(unit)?, scale))).unwrap_or((text, 1.0));
+    let value: f64 = number
+        .trim()
+        .parse()
+        .map_err(|_| format!("expected a duration like 30s, 5m, 1h or 1e3s, got {text:?} (units: ms, s, m, h)"))?;
+    if !(value.is_finite() && value > 0.0) {
+        return Err(format!("a duration must be positive and finite, got {text:?}"));
+    }
+    std::time::Duration::try_from_secs_f64(value * scale).map_err(|_| format!("{text:?} is too long a duration"))
+}
+
+fn parse_finite(s: &str) -> Result<f64, String> {
+    let value: f64 = s.trim().parse().map_err(|_| format!("expected a number, got {s:?}"))?;
+    if value.is_finite() { Ok(value) } else { Err(format!("expected a finite number, got {s:?}")) }
+}
+
+fn parse_positive_f64(s: &str) -> Result<f64, String> {
+    let value = parse_finite(s)?;
+    if value > 0.0 { Ok(value) } else { Err(format!("must be positive, got {s:?}")) }
+}
+
+fn parse_non_negative_f64(s: &str) -> Result<f64, String> {
+    let value = parse_finite(s)?;
+    if value >= 0.0 { Ok(value) } else { Err(format!("must not be negative, got {s:?}")) }
+}
+
+fn parse_positive_f32(s: &str) -> Result<f32, String> {
+    let value = parse_positive_f64(s)? as f32;
+    if value.is_finite() && value > 0.0 { Ok(value) } else { Err(format!("out of range, got {s:?}")) }
+}
+
+fn parse_fov(s: &str) -> Result<f32, String> {
+    let value = parse_finite(s)?;
+    if value > 0.0 && value < 180.0 && value as f32 > 0.0 && (value as f32) < 180.0 {
+        Ok(value as f32)
+    } else {
+        Err(format!("the field of view must be between 0 and 180 degrees (exclusive), got {s:?}"))
+    }
+}
+
+/// More threads than this would only cost memory and start-up time (and can exhaust the system's
+/// thread limit, which aborts instead of failing cleanly).
+const MAX_THREADS: usize = 1024;
+
+fn parse_threads(s: &str) -> Result<usize, String> {
+    let value: usize = s.trim().parse().map_err(|_| format!("expected a thread count, got {s:?}"))?;
+    if value <= MAX_THREADS { Ok(value) } else { Err(format!("at most {MAX_THREADS} threads, got {value}")) }
 }
 
 fn parse_emission(s: &str) -> Result<(String, Vec3), String> {

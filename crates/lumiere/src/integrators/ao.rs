@@ -31,6 +31,9 @@ impl Integrator for AmbientOcclusion {
         world.prepare_batch(&mut batch, origin, &Region::hemisphere(origin, surface.ng));
         let mut visible = 0u32;
         for k in 0..self.samples {
+            if ctx.must_stop(k) {
+                break;
+            }
             let dir = frame.to_world(sample_cosine_hemisphere(directions.get_2d(k)));
             let probe = Ray { origin, dir, tmax: self.distance };
             visible += u32::from(!world.occluded_in_batch(&batch, &probe));

@@ -89,6 +89,9 @@ impl Integrator for Direct {
                     let Some(shaft) = Region::shaft(origin, light.shadow_targets) else { continue };
                     world.prepare_batch(&mut batch, origin, &shaft);
                     for k in 0..n {
+                        if ctx.must_stop(k) {
+                            break;
+                        }
                         let Some(sample) = lights.sample_li_on(index as u32, surface.p, points.get_2d(k)) else {
                             continue;
                         };
@@ -104,6 +107,9 @@ impl Integrator for Direct {
             LightSampling::Power => {
                 let (choices, points) = (ctx.stream.next_points(n), ctx.stream.next_points(n));
                 for k in 0..n {
+                    if ctx.must_stop(k) {
+                        break;
+                    }
                     let u_light = choices.get_1d(k);
                     let Some(sample) = lights.sample_li(LightSelection::Power, surface.p, u_light, points.get_2d(k))
                     else {

@@ -75,13 +75,28 @@ impl Technique {
 
 /// Per-sample state handed to an integrator: its random numbers, reusable scratch space, and a count
 /// of the rays it traces (visibility queries included).
-#[derive(Debug)]
 pub struct SampleContext<'a> {
     /// This camera sample's random numbers; the pixel position has taken the first dimension.
     pub stream: SampleStream<'a>,
     /// Reused buffer for shared-origin ray batches (one per thread, never shared).
     pub batch: OriginBatch,
     pub rays: u64,
+    /// True once the render must stop (Ctrl-C, time budget). Integrators whose pixels can take
+    /// long (thousands of samples or lights) poll it every [`STOP_POLL`] samples and return early;
+    /// the pass is then abandoned, so the value they return is never used.
+    pub stop: &'a (dyn Fn() -> bool + Sync),
+}
+
+/// Samples between two polls of [`SampleContext::stop`]: rare enough to cost nothing, often
+/// enough to stop within milliseconds.
+pub const STOP_POLL: u32 = 1024;
+
+impl SampleContext<'_> {
+    /// Whether the render must stop, polled at sample `k` of a long loop (every `STOP_POLL`).
+    #[inline]
+    pub fn must_stop(&self, k: u32) -> bool {
+        k % STOP_POLL == STOP_POLL - 1 && (self.stop)()
+    }
 }
 
 /// Radiance along a camera ray. Implemented by plain structs and used through generics, so the

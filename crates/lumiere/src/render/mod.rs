@@ -11,6 +11,7 @@ mod options;
 pub use options::RenderOptions;
 
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{self, RecvTimeoutError};
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
@@ -136,44 +137,64 @@ fn run_passes<I: Integrator>(
     let before = stats.elapsed;
     let sampler = Sampler::new(options.sampler, options.seed);
     let tiles = tiles(camera.width, camera.height);
-    let deadline = options.time_budget.map(|budget| start + budget);
-    // Checked between passes and inside every tile, so that a costly pixel (thousands of samples,
-    // thousands of lights) neither outlives the budget nor ignores Ctrl-C for more than a row.
+    let pixel_centre = options.samples_pixel_centres();
+    let expired = AtomicBool::new(false);
+    // Checked between passes, before every pixel and inside costly pixels, so that a render of
+    // thousands of samples or lights per pixel neither outlives its budget nor ignores Ctrl-C. Two
+    // atomic loads: reading the clock per pixel would cost more than a hard-shadow pixel.
     let stop_now = || {
         if hooks.cancel.load(Ordering::Relaxed) {
             Some(StopReason::Interrupted)
-        } else if deadline.is_some_and(|d| Instant::now() >= d) {
+        } else if expired.load(Ordering::Relaxed) {
             Some(StopReason::TimeBudget)
         } else {
             None
         }
     };
-    let pixel_centre = options.samples_pixel_centres();
-    let stop = loop {
-        if film.samples >= options.spp {
-            break StopReason::Completed;
+    let (stop, result) = std::thread::scope(|scope| {
+        // The budget's watchdog: it sets `expired` at the deadline, or leaves when the render ends
+        // first (its channel closes).
+        let (render_done, watchdog) = mpsc::channel::<()>();
+        if let Some(budget) = options.time_budget {
+            let expired = &expired;
+            scope.spawn(move || {
+                if watchdog.recv_timeout(budget) == Err(RecvTimeoutError::Timeout) {
+                    expired.store(true, Ordering::Relaxed);
+                }
+            });
         }
-        if let Some(reason) = stop_now() {
-            break reason;
-        }
-        let pass = Pass { sampler: &sampler, sample: film.samples, pixel_centre };
-        let Some(tile_values) = render_pass(integrator, world, camera, &pass, &tiles, hooks.progress, &stop_now) else {
-            // The pass in flight is abandoned: the film keeps whole passes only.
-            break stop_now().unwrap_or(StopReason::Interrupted);
+        let outcome = loop {
+            if film.samples >= options.spp {
+                break (StopReason::Completed, Ok(()));
+            }
+            if let Some(reason) = stop_now() {
+                break (reason, Ok(()));
+            }
+            let pass = Pass { sampler: &sampler, sample: film.samples, pixel_centre };
+            let Some(tile_values) = render_pass(integrator, world, camera, &pass, &tiles, hooks.progress, &stop_now)
+            else {
+                // The pass in flight is abandoned: the film keeps whole passes only.
+                break (stop_now().unwrap_or(StopReason::Interrupted), Ok(()));
+            };
+            for (tile, (values, rays)) in tiles.iter().zip(tile_values) {
+                film.add_tile(tile.x0, tile.y0, tile.x1 - tile.x0, &values);
+                stats.rays += rays;
+            }
+            film.samples += 1;
+            stats.elapsed = before + start.elapsed();
+            if let Err(e) = (hooks.pass_done)(&film, &stats) {
+                break (StopReason::Interrupted, Err(e));
+            }
+            if let (Some(target), Some(error)) = (options.noise_target, film.relative_error())
+                && error <= target
+            {
+                break (StopReason::NoiseTarget, Ok(()));
+            }
         };
-        for (tile, (values, rays)) in tiles.iter().zip(tile_values) {
-            film.add_tile(tile.x0, tile.y0, tile.x1 - tile.x0, &values);
-            stats.rays += rays;
-        }
-        film.samples += 1;
-        stats.elapsed = before + start.elapsed();
-        (hooks.pass_done)(&film, &stats)?;
-        if let (Some(target), Some(error)) = (options.noise_target, film.relative_error())
-            && error <= target
-        {
-            break StopReason::NoiseTarget;
-        }
-    };
+        drop(render_done);
+        outcome
+    });
+    result?;
     stats.elapsed = before + start.elapsed();
     Ok(RenderOutput { image: film.image(), film, stats, stop })
 }
@@ -188,7 +209,7 @@ struct Pass<'a> {
 }
 
 /// One sample per pixel: per tile, its values row by row and its rays; `None` as soon as
-/// `stop_now` says so (checked before every row of every tile).
+/// `stop_now` says so (checked before every pixel, and by integrators inside costly pixels).
 fn render_pass<I: Integrator>(
     integrator: &I,
     world: &World,
@@ -202,13 +223,14 @@ fn render_pass<I: Integrator>(
         .par_iter()
         .map(|tile| {
             let stream = SampleStream::new(pass.sampler, 0, pass.sample);
-            let mut ctx = SampleContext { stream, batch: OriginBatch::default(), rays: 0 };
+            let stop = || stop_now().is_some();
+            let mut ctx = SampleContext { stream, batch: OriginBatch::default(), rays: 0, stop: &stop };
             let mut values = Vec::with_capacity(((tile.x1 - tile.x0) * (tile.y1 - tile.y0)) as usize);
             for y in tile.y0..tile.y1 {
-                if stop_now().is_some() {
-                    return None;
-                }
                 for x in tile.x0..tile.x1 {
+                    if stop_now().is_some() {
+                        return None;
+                    }
                     ctx.stream = SampleStream::new(pass.sampler, y * camera.width + x, pass.sample);
                     // The first dimension is the position in the pixel, drawn even for pixel centres
                     // so that the integrator's dimensions do not depend on it.

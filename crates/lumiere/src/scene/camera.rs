@@ -148,7 +148,13 @@ impl Camera {
 
     /// A pinhole at `eye` looking at `target`, with vertical field of view `fov_degrees`.
     pub fn look_at(eye: Vec3, target: Vec3, up: Vec3, fov_degrees: f32, width: u32, height: u32) -> Result<Camera> {
-        let forward = (target - eye)
+        let view = target - eye;
+        if !view.is_finite() {
+            return Err(Error::invalid("camera: --eye and --target are too far apart (their difference overflows)"));
+        }
+        // Scaled by its largest component first, so that a long but finite view does not overflow
+        // its squared length.
+        let forward = (view / view.abs().max_element())
             .try_normalize()
             .ok_or_else(|| Error::invalid("camera: --eye and --target are the same point"))?;
         let right = forward

@@ -40,6 +40,9 @@ pub fn run(args: &RenderArgs) -> Result<u8> {
 }
 
 fn render(args: &RenderArgs, threads: usize) -> Result<u8> {
+    for ignored in options::ignored_flags(args) {
+        output::warn(ignored);
+    }
     let load_start = Instant::now();
     let scene = load_scene(args)?;
     let load_ms = load_start.elapsed().as_secs_f64() * 1e3;
@@ -52,7 +55,9 @@ fn render(args: &RenderArgs, threads: usize) -> Result<u8> {
     let world = World::new(scene, BuildPreset::Default);
     let timings = Timings { load_ms, build_ms: build_start.elapsed().as_secs_f64() * 1e3 };
 
+    report::warn_if_unlit(&world, &options);
     let output = render_passes(args, &world, &camera, &options, &fingerprints, film, stats)?;
+    report::warn_if_black(&output);
     write_image(&args.output, output.image.width, output.image.height, &output.image.pixels, png_encoding(args))?;
     if let Some(path) = &args.checkpoint {
         fingerprints.save(path, &output.film, &output.stats)?;

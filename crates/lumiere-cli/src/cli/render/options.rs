@@ -1,4 +1,5 @@
-//! Render arguments to library options: the technique with its own options, and the rest.
+//! Render arguments to library options: the technique with its own options, and the rest; and the
+//! flags that were given but do nothing for this render.
 
 use lumiere::integrators::{AmbientOcclusion, Direct, Hits, LightSampling, Materials, Shadows, Technique};
 use lumiere::render::RenderOptions;
@@ -6,10 +7,18 @@ use lumiere::sampler::SamplerKind;
 
 use crate::cli::args::{LightSamplingArg, ModeArg, RenderArgs, SamplerArg};
 
+/// `--samples` when it is not given.
+const DEFAULT_SAMPLES: u32 = 16;
+/// The look-at camera's field of view when `--fov` is not given (gKit's).
+pub const DEFAULT_FOV: f32 = 45.0;
+
 pub fn from_args(args: &RenderArgs) -> RenderOptions {
+    // With a budget and no sample count, render until the budget is met.
+    let budget = args.time.is_some() || args.noise.is_some();
+    let spp = args.spp.unwrap_or(if budget { u32::MAX } else { 1 });
     RenderOptions {
         technique: technique(args),
-        spp: args.spp,
+        spp,
         seed: args.seed,
         sampler: match args.sampler {
             SamplerArg::Independent => SamplerKind::Independent,
@@ -21,14 +30,14 @@ pub fn from_args(args: &RenderArgs) -> RenderOptions {
 }
 
 fn technique(args: &RenderArgs) -> Technique {
-    let samples = args.samples;
+    let samples = args.samples.unwrap_or(DEFAULT_SAMPLES);
     match args.mode {
         ModeArg::Hits => Technique::Hits(Hits),
         ModeArg::Materials => Technique::Materials(Materials),
         ModeArg::Shadows => Technique::Shadows(Shadows),
         ModeArg::Direct => Technique::Direct(Direct {
             samples,
-            light_sampling: match args.light_sampling {
+            light_sampling: match args.light_sampling.unwrap_or(LightSamplingArg::PerLight) {
                 LightSamplingArg::PerLight => LightSampling::PerLight,
                 LightSamplingArg::Power => LightSampling::Power,
             },
@@ -38,4 +47,25 @@ fn technique(args: &RenderArgs) -> Technique {
             distance: args.ao_distance.unwrap_or(f32::INFINITY),
         }),
     }
+}
+
+/// One warning per flag given that this render ignores.
+pub fn ignored_flags(args: &RenderArgs) -> Vec<String> {
+    let mode = args.mode;
+    let mode_name = format!("{mode:?}").to_lowercase();
+    let mut ignored = Vec::new();
+    let mut check = |given: bool, flag: &str, applies: bool, which: &str| {
+        if given && !applies {
+            ignored.push(format!("{flag} has no effect in --mode {mode_name} ({which})"));
+        }
+    };
+    check(args.samples.is_some(), "--samples", matches!(mode, ModeArg::Direct | ModeArg::Ao), "direct and ao only");
+    check(args.light_sampling.is_some(), "--light-sampling", mode == ModeArg::Direct, "direct only");
+    check(args.ao_distance.is_some(), "--ao-distance", mode == ModeArg::Ao, "ao only");
+    if args.fov.is_some() && args.orbiter.is_some() {
+        ignored.push("--fov has no effect with --orbiter (gKit's orbiter camera uses 45 degrees)".to_string());
+    } else if args.fov.is_some() && args.scene.is_none() && args.eye.is_none() {
+        ignored.push("--fov has no effect on the built-in scene's orbiter camera; give --eye and --target".to_string());
+    }
+    ignored
 }

@@ -7,7 +7,7 @@ use std::path::Path;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use lumiere::integrators::{AmbientOcclusion, Direct, Technique};
-use lumiere::render::{RenderOptions, RenderOutput};
+use lumiere::render::{RenderOptions, RenderOutput, StopReason};
 use lumiere::scene::camera::Camera;
 use lumiere::util::write::write_atomically;
 use lumiere::world::World;
@@ -37,19 +37,24 @@ pub fn progress_bar(total: u64, done: u64) -> ProgressBar {
 /// The closing line: what was rendered, why it stopped, time, rays and speed, where it went.
 pub fn summary(options: &RenderOptions, camera: &Camera, output: &RenderOutput, threads: usize, path: &Path) {
     let noise = output.film.relative_error().map_or(String::new(), |e| format!(", relative error {e:.4}"));
+    let asked = if options.spp == u32::MAX { "unlimited".to_string() } else { options.spp.to_string() };
     output::note(format_args!(
-        "lumiere: {} {}x{}: {} after {} of {} spp{noise}; {:.1} ms ({threads} threads), {} rays, {:.1} Mrays/s -> {}",
+        "{} {}x{}: {} after {} of {asked} spp{noise}; {:.1} ms ({threads} threads), {} rays, {:.1} Mrays/s -> {}",
         options.technique.name(),
         camera.width,
         camera.height,
         output.stop.describe(),
         output.film.samples,
-        options.spp,
         output.stats.elapsed.as_secs_f64() * 1e3,
         output.stats.rays,
         output.stats.mrays_per_second(),
         path.display()
     ));
+    if output.film.samples == 0 && output.stop == StopReason::TimeBudget {
+        output::warn(
+            "the time budget ran out before the first pass completed, so the image is black: one pass takes longer than --time; give more time or fewer --samples",
+        );
+    }
     if output.film.discarded > 0 {
         output::warn(format_args!("{} non-finite or negative samples were discarded", output.film.discarded));
     }
@@ -100,5 +105,29 @@ fn samples_per_camera_sample(technique: &Technique) -> Option<u32> {
             Some(*samples)
         }
         _ => None,
+    }
+}
+
+/// Why an image may come out black, said before rendering: a technique that needs lights in a
+/// scene that has none.
+pub fn warn_if_unlit(world: &World, options: &RenderOptions) {
+    let needs_lights = matches!(options.technique, Technique::Shadows(_) | Technique::Direct(_));
+    if !needs_lights || !world.lights().is_empty() {
+        return;
+    }
+    let names: Vec<String> = world.scene().materials.iter().take(5).map(|m| format!("{:?}", m.name)).collect();
+    let more = world.scene().materials.len().saturating_sub(names.len());
+    let more = if more > 0 { format!(" and {more} more") } else { String::new() };
+    output::warn(format_args!(
+        "the scene has no emitters (no material with Ke > 0), so --mode {} renders black; make one emit with --emission NAME=r,g,b (materials: {}{more}) or try --mode ao",
+        options.technique.name(),
+        names.join(", ")
+    ));
+}
+
+/// Why an image came out black, said after rendering: no camera ray saw anything lit.
+pub fn warn_if_black(output: &RenderOutput) {
+    if output.film.samples > 0 && output.image.pixels.iter().all(|p| p.max_element() <= 0.0) {
+        output::warn("the image is black: no camera ray reached a lit surface; check the camera with --mode hits");
     }
 }
