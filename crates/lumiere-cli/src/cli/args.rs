@@ -201,7 +201,7 @@ pub struct RenderArgs {
     #[arg(long)]
     pub png_linear: bool,
 
-    /// Write render statistics (mode, size, rays, timings) as JSON to this file.
+    /// Write render statistics (mode, size, rays, timings) as JSON to this file; `-` for stdout.
     #[arg(long)]
     pub stats_json: Option<PathBuf>,
 

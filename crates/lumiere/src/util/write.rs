@@ -1,45 +1,120 @@
-//! Outputs appear atomically (temporary file, fsync, rename) and are never half-written.
+//! Outputs appear atomically (temporary file, fsync, rename) and are never half-written: readers see
+//! the old file or the complete new one. Temporary files are short-named, registered while in
+//! flight (so a process that must exit at once can remove them), and those of dead processes are
+//! cleaned up by the next run.
 
 use std::fs::{self, File, OpenOptions};
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use crate::error::{Error, Result};
 
-/// Writes arbitrary bytes atomically (same temp-then-rename rule); used by write_image and by other
-/// writers (stats JSON, checkpoints).
+/// Temporary files are named `.lumiere-<pid>-<n>.tmp`: short whatever the output's name (a
+/// 250-byte file name must still get a temporary), and telling which process made them.
+const TEMP_PREFIX: &str = ".lumiere-";
+const TEMP_SUFFIX: &str = ".tmp";
+
+/// Temporary files being written now, by any thread of this process.
+static IN_FLIGHT: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// Writes `bytes` to `path` atomically. Refuses a `path` that exists and is not a regular file (a
+/// device, a FIFO): renaming over it would replace the node itself, `/dev/null` included.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
+    check_target(path)?;
     let temp = temp_path(path)?;
     // Created separately so that a failure here (missing directory, no permission) leaves nothing to
     // clean up, and so we never remove a file we did not create.
     let file = create_new(&temp).map_err(|e| Error::io(path, e))?;
-    fill_and_rename(file, &temp, path, bytes).map_err(|e| {
+    register(&temp);
+    let result = fill_and_rename(file, &temp, path, bytes).map_err(|e| {
         // Best effort: the error worth reporting is the one that made us give up.
         let _ = fs::remove_file(&temp);
         Error::io(path, e)
-    })
+    });
+    unregister(&temp);
+    result
 }
 
 /// Checks that a file can be created at `path` (any extension) without touching `path` itself.
 pub fn check_writable(path: &Path) -> Result<()> {
-    if path.is_dir() {
-        return Err(Error::invalid(format!("{}: is a directory, expected a file name", path.display())));
-    }
+    check_target(path)?;
     let probe = temp_path(path)?;
     create_new(&probe).map_err(|e| Error::io(path, e))?;
     fs::remove_file(&probe).map_err(|e| Error::io(&probe, e))
 }
 
-/// `.{file_name}.tmp{pid}-{n}` next to `path`: the same directory keeps the final rename atomic (no
+/// Removes every temporary file this process is writing now. For a process about to exit at once
+/// (a second Ctrl-C): it leaves no half-written file behind.
+pub fn remove_in_flight() {
+    let in_flight = IN_FLIGHT.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    for temp in in_flight.iter() {
+        let _ = fs::remove_file(temp);
+    }
+}
+
+/// Removes the temporary files that processes which no longer run left in `dir` (killed with
+/// SIGKILL in the middle of a write); returns how many. Where the system cannot tell whether a
+/// process runs (no `/proc`), nothing is removed.
+pub fn remove_stale_temporaries(dir: &Path) -> usize {
+    let proc = Path::new("/proc/self");
+    if !proc.exists() {
+        return 0;
+    }
+    let Ok(entries) = fs::read_dir(if dir.as_os_str().is_empty() { Path::new(".") } else { dir }) else { return 0 };
+    let mut removed = 0;
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let Some(pid) = name.to_str().and_then(temp_owner) else { continue };
+        let alive = Path::new("/proc").join(pid.to_string()).exists();
+        if !alive && entry.file_type().is_ok_and(|t| t.is_file()) && fs::remove_file(entry.path()).is_ok() {
+            removed += 1;
+        }
+    }
+    removed
+}
+
+/// The pid in a temporary file's name `.lumiere-<pid>-<n>.tmp`, if it is one.
+fn temp_owner(name: &str) -> Option<u32> {
+    let middle = name.strip_prefix(TEMP_PREFIX)?.strip_suffix(TEMP_SUFFIX)?;
+    let (pid, n) = middle.split_once('-')?;
+    n.parse::<u64>().ok()?;
+    pid.parse().ok()
+}
+
+/// Refuses a target that exists and is not a regular file (or a link to one), and a directory.
+fn check_target(path: &Path) -> Result<()> {
+    let Ok(metadata) = fs::metadata(path) else { return Ok(()) };
+    if metadata.is_dir() {
+        return Err(Error::invalid(format!("{}: is a directory, expected a file name", path.display())));
+    }
+    if !metadata.is_file() {
+        return Err(Error::invalid(format!(
+            "{}: exists and is not a regular file (a device, FIFO or socket); lumiere writes only regular files",
+            path.display()
+        )));
+    }
+    Ok(())
+}
+
+/// `.lumiere-<pid>-<n>.tmp` next to `path`: the same directory keeps the final rename atomic (no
 /// cross-device copy), the pid separates processes and the counter separates threads of this one.
 fn temp_path(path: &Path) -> Result<PathBuf> {
     static COUNTER: AtomicU64 = AtomicU64::new(0);
-    let name =
-        path.file_name().ok_or_else(|| Error::invalid(format!("{}: output path has no file name", path.display())))?;
+    if path.file_name().is_none() {
+        return Err(Error::invalid(format!("{}: output path has no file name", path.display())));
+    }
     let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-    let temp_name = format!(".{}.tmp{}-{n}", name.to_string_lossy(), std::process::id());
-    Ok(path.with_file_name(temp_name))
+    Ok(path.with_file_name(format!("{TEMP_PREFIX}{}-{n}{TEMP_SUFFIX}", std::process::id())))
+}
+
+fn register(temp: &Path) {
+    IN_FLIGHT.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).push(temp.to_path_buf());
+}
+
+fn unregister(temp: &Path) {
+    IN_FLIGHT.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).retain(|t| t != temp);
 }
 
 /// `create_new` so that a stale file with the same name (a pid reused after a crash) is never clobbered.

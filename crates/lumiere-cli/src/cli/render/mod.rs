@@ -3,6 +3,7 @@
 mod camera;
 mod checkpointing;
 mod options;
+mod paths;
 mod report;
 mod signals;
 
@@ -10,12 +11,12 @@ use std::time::Instant;
 
 use lumiere::Result;
 use lumiere::accel::BuildPreset;
-use lumiere::image_io::{PngEncoding, check_output_path, write_image};
+use lumiere::image_io::{PngEncoding, write_image};
 use lumiere::render::film::Film;
 use lumiere::render::{Hooks, RenderOptions, RenderOutput, RenderStats, StopReason, render_progressive};
 use lumiere::scene::Scene;
 use lumiere::scene::camera::Camera;
-use lumiere::util::write::check_writable;
+use lumiere::util::write::write_atomically;
 use lumiere::world::World;
 
 use super::args::RenderArgs;
@@ -29,11 +30,8 @@ pub const EXIT_INTERRUPTED: u8 = 3;
 /// Renders; returns the process exit code (0, or `EXIT_INTERRUPTED`).
 pub fn run(args: &RenderArgs) -> Result<u8> {
     signals::install();
-    // Refuse bad output paths before spending minutes on a render.
-    check_output_path(&args.output)?;
-    for path in [&args.stats_json, &args.checkpoint].into_iter().flatten() {
-        check_writable(path)?;
-    }
+    // Refuse bad or clashing paths before spending minutes on a render.
+    paths::check(args)?;
     let pool = super::pool(args.threads)?;
     let threads = pool.current_num_threads();
     pool.install(|| render(args, threads))
@@ -64,7 +62,12 @@ fn render(args: &RenderArgs, threads: usize) -> Result<u8> {
     }
     report::summary(&options, &camera, &output, threads, &args.output);
     if let Some(path) = &args.stats_json {
-        report::stats_json(path, &world, &options, &camera, &output, threads, &timings)?;
+        let json = report::stats_json(&world, &options, &camera, &output, threads, &timings)?;
+        if path.as_os_str() == paths::STDOUT_ARG {
+            output::write_stdout(json.as_bytes())?;
+        } else {
+            write_atomically(path, json.as_bytes())?;
+        }
     }
     Ok(if output.stop == StopReason::Interrupted { EXIT_INTERRUPTED } else { 0 })
 }

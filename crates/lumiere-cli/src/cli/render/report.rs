@@ -9,7 +9,6 @@ use indicatif::{ProgressBar, ProgressStyle};
 use lumiere::integrators::{AmbientOcclusion, Direct, Technique};
 use lumiere::render::{RenderOptions, RenderOutput, StopReason};
 use lumiere::scene::camera::Camera;
-use lumiere::util::write::write_atomically;
 use lumiere::world::World;
 use lumiere::{Error, Result};
 
@@ -60,16 +59,15 @@ pub fn summary(options: &RenderOptions, camera: &Camera, output: &RenderOutput, 
     }
 }
 
-/// Writes the statistics of a render as JSON, atomically.
+/// The statistics of a render as JSON text.
 pub fn stats_json(
-    path: &Path,
     world: &World,
     options: &RenderOptions,
     camera: &Camera,
     output: &RenderOutput,
     threads: usize,
     timings: &Timings,
-) -> Result<()> {
+) -> Result<String> {
     let stats = serde_json::json!({
         "scene": world.scene().name,
         "mode": options.technique.name(),
@@ -95,7 +93,7 @@ pub fn stats_json(
         "discarded_samples": output.film.discarded,
     });
     let text = serde_json::to_string_pretty(&stats).map_err(|e| Error::invalid(format!("stats: {e}")))?;
-    write_atomically(path, format!("{text}\n").as_bytes())
+    Ok(format!("{text}\n"))
 }
 
 /// `--samples` where the technique has it (null in the JSON otherwise).

@@ -1,6 +1,6 @@
-//! SIGINT and SIGTERM: the first one stops the render cleanly (the image of every completed sample
-//! and the checkpoint are written, exit code 3); a second one quits at once. Files are written
-//! atomically, so neither leaves a half-written file.
+//! SIGINT and SIGTERM: the first one stops the render cleanly within a pixel (the image of every
+//! completed pass and the checkpoint are written, exit code 3); a second one quits at once, removing
+//! any temporary file in flight. Files are written atomically, so neither leaves a half-written file.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -17,6 +17,8 @@ const EXIT_AT_ONCE: i32 = 130;
 pub fn install() {
     if let Err(e) = ctrlc::set_handler(|| {
         if CANCEL.swap(true, Ordering::SeqCst) {
+            // An image or checkpoint may be half-written to its temporary file: remove it first.
+            lumiere::util::write::remove_in_flight();
             std::process::exit(EXIT_AT_ONCE);
         }
     }) {
