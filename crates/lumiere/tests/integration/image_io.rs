@@ -8,7 +8,7 @@ use crate::common::TempDir;
 use glam::Vec3;
 use lumiere::Error;
 use lumiere::image_io::{PngEncoding, check_output_path, linear_to_srgb8, write_image};
-use lumiere::util::write::write_atomically;
+use lumiere::util::write::{remove_stale_temporaries, write_atomically};
 
 /// The reference: IEC 61966-2-1 in f64, rounded to nearest.
 fn srgb8_exact(c: f32) -> u8 {
@@ -189,16 +189,50 @@ fn overwrite_replaces_old_content_fully() {
 }
 
 #[test]
-fn failed_rename_removes_the_temp_file_and_keeps_the_target() {
+fn writing_over_a_directory_is_refused_and_leaves_it_untouched() {
     let dir = TempDir::new("rename-fails");
-    // A non-empty directory cannot be replaced by a file: the write succeeds, the rename fails.
     let target = dir.path("taken.png");
     fs::create_dir(&target).expect("dir in the way");
     fs::write(target.join("keep"), b"keep").expect("content");
-    assert_io_error(write_image(&target, 1, 1, &[g(0.5)], PngEncoding::Srgb), &target);
+    assert_invalid(write_image(&target, 1, 1, &[g(0.5)], PngEncoding::Srgb), "directory");
     assert_eq!(dir.entries(), ["taken.png"]);
     assert_eq!(fs::read(target.join("keep")).expect("untouched"), b"keep");
     assert_invalid(check_output_path(&target), "directory");
+}
+
+/// A device node in place of an output is never replaced by a regular file (as root, a rename over
+/// `/dev/null` would succeed); a FIFO neither, and nothing blocks on it.
+#[test]
+fn existing_non_regular_targets_are_refused() {
+    assert_invalid(write_atomically(Path::new("/dev/null"), b"x"), "not a regular file");
+    let dir = TempDir::new("fifo-target");
+    let fifo = dir.path("out.json");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status().is_ok_and(|s| s.success());
+    if made {
+        assert_invalid(write_atomically(&fifo, b"x"), "not a regular file");
+        assert_eq!(dir.entries(), ["out.json"]);
+    }
+}
+
+/// Temporaries left by a process that no longer runs are removed; those of live processes and
+/// other files are kept.
+#[test]
+fn stale_temporaries_of_dead_processes_are_removed() {
+    let dir = TempDir::new("stale");
+    // pid 4194304 is above Linux's largest pid (2^22): no process can have it.
+    dir.write(".lumiere-4194304-0.tmp", "half");
+    dir.write(&format!(".lumiere-{}-7.tmp", std::process::id()), "mine, in flight");
+    dir.write(".lumiere-notapid-0.tmp", "not ours");
+    dir.write("render.png", "kept");
+    let removed = remove_stale_temporaries(&dir.0);
+    let expected_removed = usize::from(Path::new("/proc/self").exists());
+    assert_eq!(removed, expected_removed);
+    if expected_removed == 1 {
+        let mine = format!(".lumiere-{}-7.tmp", std::process::id());
+        let mut expected = vec![".lumiere-notapid-0.tmp".to_string(), mine, "render.png".to_string()];
+        expected.sort();
+        assert_eq!(dir.entries(), expected);
+    }
 }
 
 #[test]
