@@ -1,7 +1,7 @@
 //! lumiere: a CPU Monte Carlo ray tracer.
 //!
 //! Data flows one way: a [`scene::Scene`] (triangles, materials, lights) and a
-//! [`scene::camera::Camera`] go into a [`world::World`] (the scene plus its [`accel::Bvh`]), which
+//! [`scene::camera::Camera`] go into a [`world::World`] (the scene plus its [`accel::Bvh4`]), which
 //! [`render::render`] turns into an image through one of the [`integrators`]; [`image_io`] writes it.
 //!
 //! ```

@@ -2,7 +2,7 @@
 
 use glam::Vec3;
 
-use crate::accel::{BuildPreset, Bvh, Bvh4, Hit};
+use crate::accel::{BuildPreset, Bvh4, Hit, Isa};
 use crate::math::Ray;
 use crate::scene::Scene;
 use crate::scene::mesh::NO_INDEX;
@@ -11,6 +11,8 @@ pub struct World {
     pub scene: Scene,
     /// The 4-wide BVH; the binary tree it was collapsed from is dropped to save memory.
     pub bvh: Bvh4,
+    /// The instruction set, detected once here; the accel above was chosen from it.
+    pub isa: Isa,
 }
 
 /// What an integrator needs to know about a hit point.
@@ -27,8 +29,15 @@ pub struct SurfacePoint {
 
 impl World {
     pub fn new(scene: Scene, preset: BuildPreset) -> World {
-        let binary = Bvh::build(&scene.mesh.positions, &scene.mesh.indices, preset);
-        World { scene, bvh: Bvh4::from_binary(&binary) }
+        let isa = Isa::detect();
+        // The one place the accel is chosen by ISA. The 4-wide SSE kernel is the only one so far, and
+        // SSE is the x86-64 baseline (the portable kernel stands in elsewhere), so every ISA gets it.
+        let bvh = match isa {
+            Isa::Portable | Isa::Sse2 | Isa::Avx2 | Isa::Avx512 => {
+                Bvh4::build(&scene.mesh.positions, &scene.mesh.indices, preset)
+            }
+        };
+        World { scene, bvh, isa }
     }
 
     #[inline]

@@ -5,7 +5,7 @@ use std::time::Instant;
 use crate::bench::bvh::{build, median_seconds, mesh_bytes, mismatches, peak_rss_mib, trace, work_per_ray};
 use crate::bench::rays::make_ray_sets;
 use crate::bench::scenes::BenchScene;
-use lumiere::accel::BuildPreset;
+use lumiere::accel::{BuildPreset, Isa};
 use lumiere::image_io::write_atomically;
 use lumiere::world::World;
 use lumiere::{Error, Result};
@@ -41,7 +41,7 @@ pub fn run(args: &BenchBvhArgs) -> Result<()> {
         let (binary, wide) = build(&scene.mesh, BuildPreset::Default);
         let costs: Vec<String> =
             BuildPreset::ALL.iter().map(|&p| format!("{:.1}", build(&scene.mesh, p).0.sah_cost())).collect();
-        let world = World { scene, bvh: wide };
+        let world = World { scene, bvh: wide, isa: Isa::detect() };
         let sets = make_ray_sets(&world, &camera, args.seed);
         let bytes = mesh + world.bvh.memory_bytes();
         for &n in &threads {
