@@ -3,7 +3,7 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::accel::{BuildPreset, Bvh, Bvh4, Hit, OriginBatch, Region};
+use crate::accel::{BuildPreset, Bvh4, Hit, Isa, OriginBatch, Region};
 use crate::geometry::surface::SurfacePoint;
 use crate::lights::LightSet;
 use crate::materials::Material;
@@ -16,14 +16,23 @@ pub struct World {
     /// The 4-wide BVH; the binary tree it was collapsed from is dropped to save memory.
     bvh: Bvh4,
     lights: LightSet,
+    /// The instruction set, detected once here; the accel above was chosen from it.
+    isa: Isa,
 }
 
 impl World {
     /// Builds the BVH over the scene's triangles and derives its lights.
     pub fn new(scene: Scene, preset: BuildPreset) -> World {
-        let binary = Bvh::build(&scene.mesh.positions, &scene.mesh.indices, preset);
+        let isa = Isa::detect();
+        // The one place the accel is chosen by ISA. The 4-wide SSE kernel is the only one so far, and
+        // SSE is the x86-64 baseline (the portable kernel stands in elsewhere), so every ISA gets it.
+        let bvh = match isa {
+            Isa::Portable | Isa::Sse2 | Isa::Avx2 | Isa::Avx512 => {
+                Bvh4::build(&scene.mesh.positions, &scene.mesh.indices, preset)
+            }
+        };
         let lights = LightSet::new(&scene);
-        World { bvh: Bvh4::from_binary(&binary), scene, lights }
+        World { scene, bvh, lights, isa }
     }
 
     pub fn scene(&self) -> &Scene {
@@ -36,6 +45,11 @@ impl World {
 
     pub fn lights(&self) -> &LightSet {
         &self.lights
+    }
+
+    /// The instruction set detected when the world was built.
+    pub fn isa(&self) -> Isa {
+        self.isa
     }
 
     /// The material of triangle `id`.

@@ -8,6 +8,9 @@
 //! `d . edge` share a sign, and the distance needs one more dot product. Per ray that is four dot
 //! products per triangle, four triangles per SSE operation, and no traversal at all.
 //!
+//! The walk is generic in the BVH's width and kernel; the candidates are repacked four to a
+//! Plücker block whatever that width, and tested with the four-lane kernel.
+//!
 //! Watertight like the Woop test: the two triangles sharing an edge compute its vector from the
 //! same two corner vectors in swapped order, so one is exactly the negation of the other and a ray
 //! through the edge is accepted by at least one of them. When the region holds too many triangles
@@ -15,8 +18,9 @@
 
 use glam::{Vec3, Vec4};
 
-use super::simd::F32x4;
-use super::wide::{Bvh4, LEAF_BIT, leaf_blocks};
+use super::bvh2::MAX_DEPTH;
+use super::simd::{F32x4, LaneMask, Lanes, all_lanes};
+use super::wide::{LEAF_BIT, WideBvh, leaf_blocks};
 use crate::math::Ray;
 
 /// Beyond this many candidate blocks (of four triangles), per-ray traversal is cheaper.
@@ -79,32 +83,33 @@ impl Region {
         Region { planes, keep_above: [0.0; 4], count: 1 }
     }
 
-    /// Mask of the block's four triangles that do not lie wholly at or below `keep_above` of a plane.
-    fn keeps_triangles(&self, vertices: &[[[f32; 4]; 3]; 3]) -> u32 {
-        let mut kept = 0xF;
+    /// Mask of the block's `W` triangles that do not lie wholly at or below `keep_above` of a plane.
+    fn keeps_triangles<const W: usize, L: Lanes<W>>(&self, vertices: &[[[f32; W]; 3]; 3]) -> u32 {
+        let mut kept = const { all_lanes(W) };
         for (plane, &keep_above) in self.planes[..self.count].iter().zip(&self.keep_above) {
-            let distance = |corner: &[[f32; 4]; 3]| {
-                F32x4::load(&corner[0]) * F32x4::splat(plane.x)
-                    + F32x4::load(&corner[1]) * F32x4::splat(plane.y)
-                    + F32x4::load(&corner[2]) * F32x4::splat(plane.z)
-                    + F32x4::splat(plane.w)
+            let distance = |corner: &[[f32; W]; 3]| {
+                L::load(&corner[0]) * L::splat(plane.x)
+                    + L::load(&corner[1]) * L::splat(plane.y)
+                    + L::load(&corner[2]) * L::splat(plane.z)
+                    + L::splat(plane.w)
             };
             let highest = distance(&vertices[0]).max(distance(&vertices[1])).max(distance(&vertices[2]));
-            kept &= highest.gt(F32x4::splat(keep_above)).bits();
+            kept &= highest.gt(L::splat(keep_above)).bits();
         }
         kept
     }
 
-    fn contains_box(&self, node_bounds: &[[f32; 4]; 6]) -> u32 {
-        let mut inside = 0xF;
+    /// Mask of the node's `W` child boxes that reach above `keep_above` on every plane.
+    fn contains_box<const W: usize, L: Lanes<W>>(&self, node_bounds: &[[f32; W]; 6]) -> u32 {
+        let mut inside = const { all_lanes(W) };
         for (plane, &keep_above) in self.planes[..self.count].iter().zip(&self.keep_above) {
             // The corner of each box farthest along the plane normal.
             let far = |axis: usize| {
                 let row = if plane[axis] >= 0.0 { axis + 3 } else { axis };
-                F32x4::load(&node_bounds[row]) * F32x4::splat(plane[axis])
+                L::load(&node_bounds[row]) * L::splat(plane[axis])
             };
-            let distance = far(0) + far(1) + far(2) + F32x4::splat(plane.w);
-            inside &= distance.gt(F32x4::splat(keep_above)).bits();
+            let distance = far(0) + far(1) + far(2) + L::splat(plane.w);
+            inside &= distance.gt(L::splat(keep_above)).bits();
         }
         inside
     }
@@ -125,8 +130,10 @@ pub struct OriginBatch {
 }
 
 impl OriginBatch {
-    /// Gathers the triangles of `bvh` that may block rays from `origin` within `region`.
-    pub fn prepare(&mut self, bvh: &Bvh4, origin: Vec3, region: &Region) {
+    /// Gathers the triangles of `bvh` that may block rays from `origin` within `region`. Out of
+    /// line, one copy per BVH type and crate (see the note in `wide/traverse.rs`).
+    #[inline(never)]
+    pub fn prepare<const W: usize, L: Lanes<W>>(&mut self, bvh: &WideBvh<W, L>, origin: Vec3, region: &Region) {
         self.origin = origin;
         self.blocks.clear();
         self.traverse = false;
@@ -135,15 +142,17 @@ impl OriginBatch {
         }
         // Triangles kept but not yet packed into a block of four.
         let mut pending = arrayvec_like::Pending::default();
-        // Depth-first walk of the region; a wide level pushes at most four children.
-        let mut stack = [0u32; 4 * super::build::MAX_DEPTH + 1];
+        // Depth-first walk of the region; a wide level pushes at most `W` children (one row of the
+        // stack per level, as in `wide/traverse.rs`).
+        let mut rows = [[0u32; W]; MAX_DEPTH + 1];
+        let stack = rows.as_flattened_mut();
         let mut len = 1;
         while len > 0 {
             len -= 1;
             let reference = stack[len];
             if reference & LEAF_BIT != 0 {
-                for block in &bvh.blocks[leaf_blocks(reference)] {
-                    let mut kept = region.keeps_triangles(&block.vertices);
+                for block in &bvh.blocks[leaf_blocks::<W>(reference)] {
+                    let mut kept = region.keeps_triangles::<W, L>(&block.vertices);
                     while kept != 0 {
                         let lane = kept.trailing_zeros() as usize;
                         kept &= kept - 1;
@@ -166,7 +175,7 @@ impl OriginBatch {
                 continue;
             }
             let node = &bvh.nodes[reference as usize];
-            let mut mask = region.contains_box(&node.bounds);
+            let mut mask = region.contains_box::<W, L>(&node.bounds);
             while mask != 0 {
                 let slot = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
@@ -194,7 +203,7 @@ impl OriginBatch {
     /// True if the ray (which must leave from the prepared origin, inside the region) is blocked
     /// with `t` in `(0, ray.tmax]`.
     #[inline]
-    pub fn occluded(&self, bvh: &Bvh4, ray: &Ray) -> bool {
+    pub fn occluded<const W: usize, L: Lanes<W>>(&self, bvh: &WideBvh<W, L>, ray: &Ray) -> bool {
         debug_assert_eq!(ray.origin, self.origin);
         if self.traverse {
             return bvh.occluded(ray);
@@ -271,7 +280,7 @@ mod arrayvec_like {
 
     impl Pending {
         /// Appends triangle `lane` of `block`.
-        pub fn push(&mut self, block: &TriangleBlock, lane: usize) {
+        pub fn push<const W: usize>(&mut self, block: &TriangleBlock<W>, lane: usize) {
             for corner in 0..3 {
                 for axis in 0..3 {
                     self.vertices[corner][axis][self.len] = block.vertices[corner][axis][lane];

@@ -3,7 +3,8 @@
 
 use crate::common::{TestRng, grid_cube};
 use glam::Vec3;
-use lumiere::accel::{BuildPreset, Bvh, Bvh4, Hit, TraversalStats};
+use lumiere::accel::simd::portable::F32xN;
+use lumiere::accel::{BuildPreset, Bvh, Bvh4, Hit, TraversalStats, WideBvh};
 use lumiere::geometry::triangle::{WatertightRay, intersect_triangle, is_degenerate};
 use lumiere::math::Ray;
 
@@ -58,13 +59,24 @@ fn random_mesh(rng: &mut TestRng, kind: usize) -> (Vec<Vec3>, Vec<[u32; 3]>) {
     (positions, indices)
 }
 
-/// Every preset and every traversal path (binary scalar, 4-wide SIMD, counted variants) must give
-/// brute force's answer bit for bit: same triangle, same t and barycentrics, same occlusion.
+/// The 4-wide layout with the portable kernel: must answer exactly like the SSE one.
+type PortableBvh4 = WideBvh<4, F32xN<4>>;
+/// An 8-wide layout (built for blocks of 8) with the portable kernel: the layout, the collapse and
+/// the leaf encoding are generic in the width, and must stay so.
+type PortableBvh8 = WideBvh<8, F32xN<8>>;
+
+/// Every preset and every traversal path (binary scalar, 4-wide SIMD, counted variants, the
+/// portable kernel at widths 4 and 8) must give brute force's answer bit for bit: same triangle,
+/// same t and barycentrics, same occlusion.
 fn check_against_brute_force(positions: &[Vec3], indices: &[[u32; 3]], rays: &[Ray], context: &str) {
     for preset in BuildPreset::ALL {
         let bvh = Bvh::build(positions, indices, preset);
         bvh.validate().unwrap_or_else(|e| panic!("{context} {preset:?}: {e}"));
         let wide = Bvh4::from_binary(&bvh);
+        let portable = PortableBvh4::from_binary(&bvh);
+        let bvh8 = Bvh::build_for_width::<8>(positions, indices, preset);
+        bvh8.validate().unwrap_or_else(|e| panic!("{context} {preset:?} for width 8: {e}"));
+        let wide8 = PortableBvh8::from_binary(&bvh8);
         let mut stats = TraversalStats::default();
         for ray in rays {
             let expected = brute_force(positions, indices, ray);
@@ -72,6 +84,8 @@ fn check_against_brute_force(positions: &[Vec3], indices: &[[u32; 3]], rays: &[R
                 ("binary", bvh.intersect(ray), bvh.occluded(ray)),
                 ("wide", wide.intersect(ray), wide.occluded(ray)),
                 ("wide counted", wide.intersect_counted(ray, &mut stats), wide.occluded_counted(ray, &mut stats)),
+                ("wide portable", portable.intersect(ray), portable.occluded(ray)),
+                ("8-wide portable", wide8.intersect(ray), wide8.occluded(ray)),
             ];
             for (path, hit, occluded) in paths {
                 assert_eq!(hit, expected, "{context} {preset:?} {path} {ray:?}");
@@ -147,7 +161,8 @@ fn origin_batches_agree_with_traversal() {
     for mesh_index in 0..120 {
         let (positions, indices) = random_mesh(&mut rng, 2 + mesh_index % 3);
         let wide = Bvh4::from_binary(&Bvh::build(&positions, &indices, BuildPreset::Default));
-        let mut batch = OriginBatch::default();
+        let wide8 = PortableBvh8::build(&positions, &indices, BuildPreset::Default);
+        let (mut batch, mut batch8) = (OriginBatch::default(), OriginBatch::default());
         for _ in 0..8 {
             let origin = rng.vec3(-12.0, 12.0);
             let corners = [rng.vec3(-12.0, 12.0), rng.vec3(-12.0, 12.0), rng.vec3(-12.0, 12.0)];
@@ -158,6 +173,10 @@ fn origin_batches_agree_with_traversal() {
             };
             batch.prepare(&wide, origin, &region);
             batched += usize::from(batch.candidate_blocks().is_some());
+            // The candidates are the triangles that survive culling, whatever the tree: an 8-wide
+            // walk must gather the same ones (possibly packed in another order).
+            batch8.prepare(&wide8, origin, &region);
+            assert_eq!(batch8.candidate_blocks(), batch.candidate_blocks(), "mesh {mesh_index}");
             for _ in 0..64 {
                 let ray = if shaft {
                     let (a, b) = (rng.f32(), rng.f32());
@@ -169,7 +188,9 @@ fn origin_batches_agree_with_traversal() {
                     Ray::new(origin, if d.dot(normal) < 0.0 { -d } else { d })
                 };
                 rays += 1;
-                differ += usize::from(batch.occluded(&wide, &ray) != wide.occluded(&ray));
+                let occluded = batch.occluded(&wide, &ray);
+                differ += usize::from(occluded != wide.occluded(&ray));
+                assert_eq!(batch8.occluded(&wide8, &ray), occluded, "mesh {mesh_index}: 8-wide batch {ray:?}");
             }
         }
     }

@@ -54,14 +54,16 @@ impl BuildPreset {
     }
 }
 
-/// Relative cost of visiting a node versus testing one block of four triangles.
+/// Relative cost of visiting a node versus testing one block of triangles.
 const TRAVERSAL_COST: f64 = 1.0;
 const INTERSECTION_COST: f64 = 1.0;
 
-/// Leaves are tested four triangles at a time (see `wide.rs`), so a leaf of 1 to 4 triangles costs
-/// one block test: counting blocks instead of triangles fills the leaves' SIMD lanes.
-pub(super) fn leaf_cost(count: usize) -> f64 {
-    count.div_ceil(4) as f64
+/// The wide layouts test leaves `block_width` triangles at a time (see `wide/`), so a leaf of 1 to
+/// `block_width` triangles costs one block test: counting blocks instead of triangles fills the
+/// leaves' SIMD lanes. The build passes its const width, so the division is a shift for 4 or 8.
+#[inline(always)]
+pub(super) fn leaf_cost(count: usize, block_width: usize) -> f64 {
+    count.div_ceil(block_width) as f64
 }
 
 /// Nodes with more triangles than this bin them in parallel chunks (the top levels, where
@@ -109,13 +111,15 @@ impl NodeBounds {
     }
 }
 
-struct Context<'a> {
+/// What every node of one build shares. `W` is the block width the SAH counts leaves in: a const,
+/// not a field, so that `leaf_cost` divides by a constant in the split sweep.
+struct Context<'a, const W: usize> {
     bounds: &'a [Box3A],
     centroids: &'a [Vec3A],
     bins: usize,
 }
 
-impl Context<'_> {
+impl<const W: usize> Context<'_, W> {
     fn node_bounds(&self, order: &[u32]) -> NodeBounds {
         let gather = |ids: &[u32]| {
             ids.iter().fold(NodeBounds::EMPTY, |acc, &i| NodeBounds {
@@ -131,7 +135,7 @@ impl Context<'_> {
     }
 }
 
-pub fn build(positions: &[Vec3], indices: &[[u32; 3]], preset: BuildPreset) -> Bvh {
+pub fn build<const W: usize>(positions: &[Vec3], indices: &[[u32; 3]], preset: BuildPreset) -> Bvh {
     let corners = |t: &[u32; 3]| t.map(|i| positions[i as usize]);
     let bounds: Vec<Box3A> = indices
         .par_iter()
@@ -148,17 +152,17 @@ pub fn build(positions: &[Vec3], indices: &[[u32; 3]], preset: BuildPreset) -> B
             !is_degenerate(p0, p1, p2)
         })
         .collect();
-    let ctx = Context { bounds: &bounds, centroids: &centroids, bins: preset.bins() };
+    let ctx = Context::<W> { bounds: &bounds, centroids: &centroids, bins: preset.bins() };
 
     let nodes =
         if order.is_empty() { vec![Node::new(Aabb::EMPTY, 0, 0)] } else { build_subtree(&ctx, &mut order, 0, 0) };
     let vertices = order.iter().map(|&id| corners(&indices[id as usize])).collect();
-    Bvh { nodes, vertices, triangle_ids: order, input_triangles: indices.len() }
+    Bvh { nodes, vertices, triangle_ids: order, input_triangles: indices.len(), block_width: W }
 }
 
 /// Builds the subtree over `order` (whose first element is triangle slot `offset` in leaf order)
 /// into a node array whose root is at index 0.
-fn build_subtree(ctx: &Context, order: &mut [u32], offset: usize, depth: usize) -> Vec<Node> {
+fn build_subtree<const W: usize>(ctx: &Context<W>, order: &mut [u32], offset: usize, depth: usize) -> Vec<Node> {
     let mut nodes = Vec::with_capacity(order.len());
     nodes.push(Node::default());
     build_into(ctx, order, offset, depth, 0, &mut nodes);
@@ -166,7 +170,14 @@ fn build_subtree(ctx: &Context, order: &mut [u32], offset: usize, depth: usize) 
 }
 
 /// Fills node `index` of `nodes` for the triangles `order`, appending its descendants.
-fn build_into(ctx: &Context, order: &mut [u32], offset: usize, depth: usize, index: usize, nodes: &mut Vec<Node>) {
+fn build_into<const W: usize>(
+    ctx: &Context<W>,
+    order: &mut [u32],
+    offset: usize,
+    depth: usize,
+    index: usize,
+    nodes: &mut Vec<Node>,
+) {
     let node_bounds = ctx.node_bounds(order);
     let bounds = node_bounds.bounds.to_aabb();
     let Some(mid) = choose_split(ctx, order, &bounds, &node_bounds.centroids.to_aabb(), depth) else {
@@ -213,8 +224,8 @@ fn stitch(nodes: &mut Vec<Node>, first_child: usize, left: Vec<Node>, right: Vec
 }
 
 /// Decides whether to split `order`; if so, partitions it in place and returns the size of the left part.
-fn choose_split(
-    ctx: &Context,
+fn choose_split<const W: usize>(
+    ctx: &Context<W>,
     order: &mut [u32],
     bounds: &Aabb,
     centroid_bounds: &Aabb,
@@ -235,7 +246,7 @@ fn choose_split(
     let Some(split) = best_binned_split(ctx, order, centroid_bounds) else {
         return median_split(ctx, order, extent.max_position());
     };
-    let as_leaf = INTERSECTION_COST * leaf_cost(count);
+    let as_leaf = INTERSECTION_COST * leaf_cost(count, W);
     let split_cost = TRAVERSAL_COST + INTERSECTION_COST * split.cost / bounds.half_area();
     if count <= MAX_LEAF_SIZE && as_leaf <= split_cost {
         return None;
@@ -247,7 +258,7 @@ fn choose_split(
 }
 
 /// Halves `order` by centroid along `axis`, or makes a leaf if it is small enough.
-fn median_split(ctx: &Context, order: &mut [u32], axis: usize) -> Option<usize> {
+fn median_split<const W: usize>(ctx: &Context<W>, order: &mut [u32], axis: usize) -> Option<usize> {
     if order.len() <= MAX_LEAF_SIZE {
         return None;
     }
@@ -285,7 +296,12 @@ impl Bin {
 type BinGrid<const B: usize> = [[Bin; B]; 3];
 
 /// Bins the centroids of `order` along the three axes at once.
-fn bin_triangles<const B: usize>(ctx: &Context, order: &[u32], min: Vec3A, scale: Vec3A) -> BinGrid<B> {
+fn bin_triangles<const W: usize, const B: usize>(
+    ctx: &Context<W>,
+    order: &[u32],
+    min: Vec3A,
+    scale: Vec3A,
+) -> BinGrid<B> {
     let last = Vec3A::splat((B - 1) as f32);
     let mut grid = [[Bin::EMPTY; B]; 3];
     for &i in order {
@@ -312,15 +328,19 @@ fn merge_grids<const B: usize>(mut a: BinGrid<B>, b: BinGrid<B>) -> BinGrid<B> {
 
 /// The cheapest bin boundary over the three axes, or None if every candidate puts all triangles
 /// on one side (possible only for degenerate centroid layouts).
-fn best_binned_split(ctx: &Context, order: &[u32], centroid_bounds: &Aabb) -> Option<Split> {
+fn best_binned_split<const W: usize>(ctx: &Context<W>, order: &[u32], centroid_bounds: &Aabb) -> Option<Split> {
     match ctx.bins {
-        8 => best_binned_split_with::<8>(ctx, order, centroid_bounds),
-        16 => best_binned_split_with::<16>(ctx, order, centroid_bounds),
-        _ => best_binned_split_with::<64>(ctx, order, centroid_bounds),
+        8 => best_binned_split_with::<W, 8>(ctx, order, centroid_bounds),
+        16 => best_binned_split_with::<W, 16>(ctx, order, centroid_bounds),
+        _ => best_binned_split_with::<W, 64>(ctx, order, centroid_bounds),
     }
 }
 
-fn best_binned_split_with<const B: usize>(ctx: &Context, order: &[u32], centroid_bounds: &Aabb) -> Option<Split> {
+fn best_binned_split_with<const W: usize, const B: usize>(
+    ctx: &Context<W>,
+    order: &[u32],
+    centroid_bounds: &Aabb,
+) -> Option<Split> {
     let bins = B;
     let extent = centroid_bounds.extent();
     let scale = Vec3::select(extent.cmpgt(Vec3::ZERO), bins as f32 / extent, Vec3::ZERO);
@@ -328,10 +348,10 @@ fn best_binned_split_with<const B: usize>(ctx: &Context, order: &[u32], centroid
     let grid = if order.len() > PARALLEL_BINNING_THRESHOLD {
         order
             .par_chunks(BINNING_CHUNK)
-            .map(|chunk| bin_triangles::<B>(ctx, chunk, min, scale_a))
+            .map(|chunk| bin_triangles::<W, B>(ctx, chunk, min, scale_a))
             .reduce(|| [[Bin::EMPTY; B]; 3], merge_grids)
     } else {
-        bin_triangles::<B>(ctx, order, min, scale_a)
+        bin_triangles::<W, B>(ctx, order, min, scale_a)
     };
 
     let mut best: Option<Split> = None;
@@ -345,7 +365,7 @@ fn best_binned_split_with<const B: usize>(ctx: &Context, order: &[u32], centroid
         let mut acc = Bin::EMPTY;
         for k in (1..bins).rev() {
             acc = acc.merge(row[k]);
-            right_cost[k] = acc.bounds.to_aabb().half_area() * leaf_cost(acc.count as usize);
+            right_cost[k] = acc.bounds.to_aabb().half_area() * leaf_cost(acc.count as usize, W);
         }
         let mut left = Bin::EMPTY;
         for k in 1..bins {
@@ -353,7 +373,7 @@ fn best_binned_split_with<const B: usize>(ctx: &Context, order: &[u32], centroid
             if left.count == 0 || left.count as usize == order.len() {
                 continue;
             }
-            let cost = left.bounds.to_aabb().half_area() * leaf_cost(left.count as usize) + right_cost[k];
+            let cost = left.bounds.to_aabb().half_area() * leaf_cost(left.count as usize, W) + right_cost[k];
             if best.as_ref().is_none_or(|b| cost < b.cost) {
                 best = Some(Split { axis, bin: k, cost, scale: scale[axis] });
             }

@@ -1,0 +1,75 @@
+//! SIMD lanes for the wide BVH: a lane trait, its kernels, and the one place the instruction set is
+//! detected.
+//!
+//! The wide traversal and the batches are written once against [`Lanes`]; a kernel is a type
+//! implementing it for one width. Today there are two: [`sse::F32x4`] (four lanes, SSE, part of the
+//! x86-64 baseline, so it needs no runtime detection) and [`portable::F32xN`] (plain arrays, any
+//! width: the fallback on other architectures, and a second implementation the tests check the SSE
+//! one against). An AVX2 or AVX-512 kernel is one more type implementing `Lanes<8>` or `Lanes<16>`,
+//! entered through a `#[target_feature]` function whose SAFETY line names [`Isa::detect`], plus one
+//! more arm where `World::new` picks the accel from the detected [`Isa`].
+//!
+//! Kernels must not contract multiplies and adds into FMAs (Rust never does so implicitly): the wide
+//! triangle test must round exactly like the scalar one.
+
+mod isa;
+pub mod portable;
+#[cfg(target_arch = "x86_64")]
+pub mod sse;
+
+use std::fmt::Debug;
+use std::ops::{Add, BitAnd, BitOr, Div, Mul, Sub};
+
+pub use isa::Isa;
+
+/// The four-lane kernel every build has: SSE on x86-64, plain arrays elsewhere.
+#[cfg(target_arch = "x86_64")]
+pub type F32x4 = sse::F32x4;
+/// The four-lane kernel every build has: SSE on x86-64, plain arrays elsewhere.
+#[cfg(not(target_arch = "x86_64"))]
+pub type F32x4 = portable::F32xN<4>;
+
+/// `W` f32 lanes: only the operations the wide BVH needs, each one instruction in a SIMD kernel.
+///
+/// Min and max follow SSE: where either lane is NaN they return `b`'s lane. The wide box test relies
+/// on it (an empty child's NaN box never admits a ray), so every kernel must do the same.
+pub trait Lanes<const W: usize>:
+    Copy + Debug + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Div<Output = Self>
+{
+    /// One boolean per lane, as comparisons return it.
+    type Mask: LaneMask;
+
+    fn splat(v: f32) -> Self;
+    fn load(a: &[f32; W]) -> Self;
+    fn to_array(self) -> [f32; W];
+    /// Lane-wise minimum; `b`'s lane where either lane is NaN.
+    fn min(self, b: Self) -> Self;
+    /// Lane-wise maximum; `b`'s lane where either lane is NaN.
+    fn max(self, b: Self) -> Self;
+    fn lt(self, b: Self) -> Self::Mask;
+    fn le(self, b: Self) -> Self::Mask;
+    fn gt(self, b: Self) -> Self::Mask;
+    fn eq(self, b: Self) -> Self::Mask;
+    fn ne(self, b: Self) -> Self::Mask;
+    /// Lane-wise absolute value (clears the sign bit).
+    fn abs(self) -> Self;
+
+    /// Lanes that are neither infinite nor NaN.
+    #[inline(always)]
+    fn is_finite(self) -> Self::Mask {
+        // Both comparisons are false for NaN, one of them for an infinity.
+        Self::splat(-f32::MAX).le(self) & self.le(Self::splat(f32::MAX))
+    }
+}
+
+/// The result of a lane comparison.
+pub trait LaneMask: Copy + Debug + BitAnd<Output = Self> + BitOr<Output = Self> {
+    /// Bit `i` set where lane `i` is true; no bits above the width.
+    fn bits(self) -> u32;
+}
+
+/// Bits `0..width` set: the mask of all lanes, for complementing [`LaneMask::bits`].
+pub const fn all_lanes(width: usize) -> u32 {
+    assert!(width != 0 && width <= 32, "a lane mask is a u32");
+    u32::MAX >> (32 - width)
+}

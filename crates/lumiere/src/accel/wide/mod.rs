@@ -1,0 +1,57 @@
+//! The wide BVH used for rendering: the binary SAH tree collapsed so that each node holds up to `W`
+//! children, whose boxes are tested together in one SIMD pass, and leaves stored as blocks of `W`
+//! triangles in SoA layout, tested together too.
+//!
+//! The layout (nodes, blocks, collapse, leaf references) is generic in the width `W`; the traversal
+//! is generic over the lane kernel `L` (see `simd/`). The renderer instantiates `W = 4` with the SSE
+//! kernel ([`crate::accel::Bvh4`]): SSE is part of the x86-64 baseline, so the binary runs on every
+//! x86-64 CPU; eight lanes need AVX2, a kernel that does not exist yet.
+
+mod collapse;
+mod leaf;
+mod node;
+mod traverse;
+mod triangles;
+
+use std::marker::PhantomData;
+
+use glam::Vec3;
+
+pub(super) use leaf::{LEAF_BIT, blocks as leaf_blocks};
+pub use node::{TriangleBlock, WideNode};
+
+use super::bvh2::{BuildPreset, Bvh};
+
+/// A `W`-wide BVH traversed with the lanes `L` (a [`crate::accel::simd::Lanes<W>`] kernel).
+#[derive(Clone, Debug)]
+pub struct WideBvh<const W: usize, L> {
+    pub(super) nodes: Vec<WideNode<W>>,
+    pub(super) blocks: Vec<TriangleBlock<W>>,
+    triangle_count: usize,
+    /// The kernel is part of the type, so that the accel a world chose fixes its traversal code.
+    /// (`fn() -> L`: the BVH owns no `L`, and stays `Send` and `Sync` whatever `L` is.)
+    kernel: PhantomData<fn() -> L>,
+}
+
+impl<const W: usize, L> WideBvh<W, L> {
+    /// Children per node and triangles per block.
+    pub const WIDTH: usize = W;
+
+    /// Builds the binary SAH tree for blocks of `W` triangles and collapses it.
+    pub fn build(positions: &[Vec3], indices: &[[u32; 3]], preset: BuildPreset) -> Self {
+        Self::from_binary(&Bvh::build_for_width::<W>(positions, indices, preset))
+    }
+
+    pub fn nodes(&self) -> &[WideNode<W>] {
+        &self.nodes
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.triangle_count
+    }
+
+    /// Bytes held by the nodes and the triangle blocks.
+    pub fn memory_bytes(&self) -> usize {
+        self.nodes.len() * size_of::<WideNode<W>>() + self.blocks.len() * size_of::<TriangleBlock<W>>()
+    }
+}

@@ -1,0 +1,239 @@
+//! Closest-hit and occlusion queries on the wide BVH: one `W`-lane box test per node, one `W`-lane
+//! watertight triangle test per leaf block (`triangles.rs`), iterative with a fixed stack, nearest
+//! child first. Generic over the lane kernel `L`; each entry point is monomorphised per kernel.
+
+use std::mem::MaybeUninit;
+
+use super::WideBvh;
+use super::leaf::{self, LEAF_BIT};
+use super::node::WideNode;
+use super::triangles::{TriangleRay, intersect_block};
+use crate::accel::bvh2::MAX_DEPTH;
+use crate::accel::simd::{LaneMask, Lanes};
+use crate::accel::slab::{BOX_EXPANSION, PRUNE_SLACK, safe_reciprocal};
+use crate::accel::{Hit, TraversalStats};
+use crate::math::Ray;
+
+/// The traversal stack, left uninitialised: zeroing it (2.3 KB per ray at `W = 4`) was measured to
+/// cost more than the whole traversal of a small scene. A wide level pushes at most `W - 1`
+/// siblings, so `(W - 1) * MAX_DEPTH + 1` entries would do; stable Rust cannot size an array by an
+/// expression of a const parameter, so the stack holds one row of `W` entries per level.
+struct Stack<const W: usize> {
+    entries: [[MaybeUninit<(u32, f32)>; W]; MAX_DEPTH + 1],
+    len: usize,
+}
+
+impl<const W: usize> Stack<W> {
+    #[inline(always)]
+    fn new() -> Self {
+        Stack { entries: [[MaybeUninit::uninit(); W]; MAX_DEPTH + 1], len: 0 }
+    }
+
+    #[inline(always)]
+    fn push(&mut self, entry: (u32, f32)) {
+        // The build bounds the depth by MAX_DEPTH and each level pushes at most W - 1 entries.
+        self.entries.as_flattened_mut()[self.len] = MaybeUninit::new(entry);
+        self.len += 1;
+    }
+
+    #[inline(always)]
+    fn pop(&mut self) -> Option<(u32, f32)> {
+        self.len = self.len.checked_sub(1)?;
+        // SAFETY: entries below `len` were written by `push` before `len` grew past them.
+        Some(unsafe { self.entries.as_flattened()[self.len].assume_init() })
+    }
+}
+
+/// The ray, splatted for the box tests.
+struct BoxRay<L> {
+    /// Per axis, the bounds row that holds the entry (near) plane: min when the direction is positive.
+    near_row: [usize; 3],
+    origin: [L; 3],
+    inv_dir: [L; 3],
+}
+
+impl<L> BoxRay<L> {
+    #[inline(always)]
+    fn new<const W: usize>(ray: &Ray) -> Self
+    where
+        L: Lanes<W>,
+    {
+        let d = ray.dir.to_array();
+        let o = ray.origin.to_array();
+        BoxRay {
+            near_row: [0, 1, 2].map(|a| if d[a] >= 0.0 { a } else { a + 3 }),
+            origin: o.map(L::splat),
+            inv_dir: d.map(|v| L::splat(safe_reciprocal(v))),
+        }
+    }
+
+    /// Entry distances of the `W` children and the mask (bit per child) of those the ray enters
+    /// before `tmax`. NaN boxes (empty slots) always fail: NaN is kept as the second operand of
+    /// every min/max, and comparisons with NaN are false.
+    #[inline(always)]
+    fn enter<const W: usize>(&self, node: &WideNode<W>, tmax: L) -> (u32, [f32; W])
+    where
+        L: Lanes<W>,
+    {
+        let mut near = L::splat(0.0);
+        let mut far = tmax;
+        for axis in 0..3 {
+            let near_plane = L::load(&node.bounds[self.near_row[axis]]);
+            let far_plane = L::load(&node.bounds[(self.near_row[axis] + 3) % 6]);
+            near = near.max((near_plane - self.origin[axis]) * self.inv_dir[axis]);
+            far = far.min((far_plane - self.origin[axis]) * self.inv_dir[axis] * L::splat(BOX_EXPANSION));
+        }
+        (near.le(far).bits(), near.to_array())
+    }
+}
+
+// The entry points stay out of line, one copy per kernel and crate, like the non-generic 4-wide
+// functions they replaced: a generic function may otherwise be inlined at each call site, which
+// would change the code the renders and benchmarks were measured with.
+impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
+    /// The closest hit with `t` in `(0, ray.tmax]`, ties to the lower triangle id; identical to
+    /// [`crate::accel::Bvh::intersect`].
+    #[inline(never)]
+    pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        self.intersect_impl::<false>(ray, &mut TraversalStats::default())
+    }
+
+    /// As [`WideBvh::intersect`], counting nodes and blocks visited into `stats`.
+    #[inline(never)]
+    pub fn intersect_counted(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
+        self.intersect_impl::<true>(ray, stats)
+    }
+
+    /// True if anything lies on the ray with `t` in `(0, ray.tmax]`.
+    #[inline(never)]
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        self.occluded_impl::<false>(ray, &mut TraversalStats::default())
+    }
+
+    /// As [`WideBvh::occluded`], counting nodes and blocks visited into `stats`.
+    #[inline(never)]
+    pub fn occluded_counted(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
+        self.occluded_impl::<true>(ray, stats)
+    }
+
+    #[inline(always)]
+    fn intersect_impl<const COUNT: bool>(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
+        let box_ray = BoxRay::<L>::new::<W>(ray);
+        let tri_ray = TriangleRay::<L>::new::<W>(ray);
+        let mut best: Option<Hit> = None;
+        let mut tmax = ray.tmax;
+        let mut stack = Stack::<W>::new();
+        let mut current = (0u32, 0f32);
+        loop {
+            let (reference, near) = current;
+            if near <= tmax * PRUNE_SLACK {
+                if reference & LEAF_BIT != 0 {
+                    for block in &self.blocks[leaf::blocks::<W>(reference)] {
+                        if COUNT {
+                            stats.blocks += 1;
+                        }
+                        let hits = intersect_block(&tri_ray, block, tmax);
+                        let mut mask = hits.mask;
+                        while mask != 0 {
+                            let lane = mask.trailing_zeros() as usize;
+                            mask &= mask - 1;
+                            let (t, id) = (hits.t[lane], block.ids[lane]);
+                            if best.is_none_or(|b| t < b.t || (t == b.t && id < b.triangle)) {
+                                best = Some(Hit { t, triangle: id, u: hits.u[lane], v: hits.v[lane] });
+                                tmax = t;
+                            }
+                        }
+                    }
+                } else {
+                    if COUNT {
+                        stats.nodes += 1;
+                    }
+                    let node = &self.nodes[reference as usize];
+                    let (mask, nears) = box_ray.enter(node, L::splat(tmax * PRUNE_SLACK));
+                    if let Some(next) = push_children(node, mask, &nears, &mut stack) {
+                        current = next;
+                        continue;
+                    }
+                }
+            }
+            match stack.pop() {
+                Some(next) => current = next,
+                None => return best,
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn occluded_impl<const COUNT: bool>(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
+        let box_ray = BoxRay::<L>::new::<W>(ray);
+        let tri_ray = TriangleRay::<L>::new::<W>(ray);
+        let tmax = ray.tmax;
+        let tmax_lanes = L::splat(tmax * PRUNE_SLACK);
+        let mut stack = Stack::<W>::new();
+        let mut current = (0u32, 0f32);
+        loop {
+            let (reference, _) = current;
+            if reference & LEAF_BIT != 0 {
+                for block in &self.blocks[leaf::blocks::<W>(reference)] {
+                    if COUNT {
+                        stats.blocks += 1;
+                    }
+                    if intersect_block(&tri_ray, block, tmax).mask != 0 {
+                        return true;
+                    }
+                }
+            } else {
+                if COUNT {
+                    stats.nodes += 1;
+                }
+                let node = &self.nodes[reference as usize];
+                let (mask, nears) = box_ray.enter(node, tmax_lanes);
+                if let Some(next) = push_children(node, mask, &nears, &mut stack) {
+                    current = next;
+                    continue;
+                }
+            }
+            match stack.pop() {
+                Some(next) => current = next,
+                None => return false,
+            }
+        }
+    }
+}
+
+/// Pushes the entered children but the nearest, farthest first, and returns the nearest to visit next.
+#[inline(always)]
+fn push_children<const W: usize>(
+    node: &WideNode<W>,
+    mask: u32,
+    nears: &[f32; W],
+    stack: &mut Stack<W>,
+) -> Option<(u32, f32)> {
+    if mask == 0 {
+        return None;
+    }
+    let first = mask.trailing_zeros() as usize;
+    if mask & (mask - 1) == 0 {
+        return Some((node.children[first], nears[first]));
+    }
+    // Two to W children: sort them by entry distance, nearest last (insertion sort on <= W items).
+    let mut entries = [(0u32, 0f32); W];
+    let mut count = 0;
+    let mut bits = mask;
+    while bits != 0 {
+        let lane = bits.trailing_zeros() as usize;
+        bits &= bits - 1;
+        let entry = (node.children[lane], nears[lane]);
+        let mut i = count;
+        while i > 0 && entries[i - 1].1 < entry.1 {
+            entries[i] = entries[i - 1];
+            i -= 1;
+        }
+        entries[i] = entry;
+        count += 1;
+    }
+    for &entry in &entries[..count - 1] {
+        stack.push(entry);
+    }
+    Some(entries[count - 1])
+}
