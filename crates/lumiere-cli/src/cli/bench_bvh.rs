@@ -12,6 +12,7 @@ use lumiere::{Error, Result};
 
 use super::args::BenchBvhArgs;
 use super::export::export_ray_sets;
+use super::output;
 use super::pool;
 
 pub fn run(args: &BenchBvhArgs) -> Result<()> {
@@ -35,7 +36,7 @@ pub fn run(args: &BenchBvhArgs) -> Result<()> {
         let camera = bench.camera()?;
         let triangles = scene.mesh.triangle_count();
         let mesh = mesh_bytes(&scene.mesh);
-        eprintln!("{}: {triangles} triangles loaded in {load_ms:.0} ms", bench.name);
+        output::note(format_args!("{}: {triangles} triangles loaded in {load_ms:.0} ms", bench.name));
 
         // Reference structures and ray sets, built once.
         let binary = Bvh::build(&scene.mesh.positions, &scene.mesh.indices, BuildPreset::Default);
@@ -79,12 +80,12 @@ pub fn run(args: &BenchBvhArgs) -> Result<()> {
                 ));
                 json.push(serde_json::json!({"scene": bench.name, "threads": n, "what": "trace", "kind": set.kind, "query": set.query.name(), "rays": set.rays.len(), "median_s": seconds, "mrays_per_s": mrays, "nodes_per_ray": nodes, "blocks_per_ray": blocks, "mismatches": wrong}));
                 if wrong != 0 {
-                    eprintln!(
-                        "lumiere: warning: {} {} {}: {wrong} rays differ from the scalar reference",
+                    output::warn(format_args!(
+                        "{} {} {}: {wrong} rays differ from the scalar reference",
                         bench.name,
                         set.kind,
                         set.query.name()
-                    );
+                    ));
                 }
             }
         }
@@ -92,15 +93,19 @@ pub fn run(args: &BenchBvhArgs) -> Result<()> {
             export_ray_sets(&dir.join(bench.name), &world, &sets)?;
         }
     }
-    println!(
-        "| scene | threads | triangles | load ms | build ms | nodes binary / 4-wide | SAH fast / default / high | bytes/tri | peak RSS MiB |"
-    );
-    println!("|---|---|---|---|---|---|---|---|---|");
-    builds.iter().for_each(|row| println!("{row}"));
-    println!();
-    println!("| scene | rays | threads | count | median ms | Mrays/s | nodes/ray | blocks/ray | mismatches |");
-    println!("|---|---|---|---|---|---|---|---|---|");
-    traces.iter().for_each(|row| println!("{row}"));
+    output::print(
+        "| scene | threads | triangles | load ms | build ms | nodes binary / 4-wide | SAH fast / default / high | bytes/tri | peak RSS MiB |",
+    )?;
+    output::print("|---|---|---|---|---|---|---|---|---|")?;
+    for row in &builds {
+        output::print(row)?;
+    }
+    output::print("")?;
+    output::print("| scene | rays | threads | count | median ms | Mrays/s | nodes/ray | blocks/ray | mismatches |")?;
+    output::print("|---|---|---|---|---|---|---|---|---|")?;
+    for row in &traces {
+        output::print(row)?;
+    }
     if let Some(path) = &args.json {
         let text = serde_json::to_string_pretty(&json).map_err(|e| Error::invalid(format!("json: {e}")))?;
         write_atomically(path, text.as_bytes())?;
