@@ -331,11 +331,14 @@ pub fn with_checksum(body: &[u8]) -> Vec<u8> {
     [body, &hasher.finish().to_le_bytes()].concat()
 }
 
+/// The options text of [`raw_checkpoint`]'s files.
+pub const RAW_OPTIONS: &str = "technique: Hits(Hits)\nseed: 7\n";
+
 /// A checkpoint file written field by field, with a valid checksum: `pixels` pixels of data
 /// (whatever `width` and `height` say), for crafting inconsistent files.
 pub fn raw_checkpoint(width: u32, height: u32, samples: u32, elapsed: f64, pixels: usize) -> Vec<u8> {
     let mut body = b"LUMCKPT1".to_vec();
-    body.extend_from_slice(&1u32.to_le_bytes());
+    body.extend_from_slice(&2u32.to_le_bytes());
     body.extend_from_slice(&0x5C3u64.to_le_bytes());
     body.extend_from_slice(&0x0F7u64.to_le_bytes());
     for v in [width, height, samples] {
@@ -348,6 +351,8 @@ pub fn raw_checkpoint(width: u32, height: u32, samples: u32, elapsed: f64, pixel
     for i in 0..pixels * 4 {
         body.extend_from_slice(&(i as f64 * 0.25).to_le_bytes());
     }
+    body.extend_from_slice(&(RAW_OPTIONS.len() as u32).to_le_bytes());
+    body.extend_from_slice(RAW_OPTIONS.as_bytes());
     with_checksum(&body)
 }
 

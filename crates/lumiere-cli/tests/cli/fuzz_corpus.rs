@@ -127,7 +127,10 @@ fn forged_checkpoints_are_refused_for_their_reason() {
         ("binary-garbage.ckpt", "no checkpoint header"),
         ("truncated-pixels.ckpt", "checksum does not match"),
         ("bad-checksum.ckpt", "checksum does not match"),
-        ("version-2.ckpt", "unsupported version"),
+        // Written when version 2 did not exist: a version-2 header over a version-1 body.
+        ("version-2.ckpt", "its size does not match its pixel data"),
+        ("valid-1x1.ckpt", "version 1, written by an older lumiere"),
+        ("valid-3x2.ckpt", "version 1, written by an older lumiere"),
         ("zero-width.ckpt", "its size does not match its pixel data"),
         ("size-mismatch.ckpt", "its size does not match its pixel data"),
         ("nan-elapsed.ckpt", "invalid elapsed time"),
@@ -145,10 +148,18 @@ fn forged_checkpoints_are_refused_for_their_reason() {
             }
         }
     }
-    // Valid files (checksums computed independently of lumiere's code) load exactly.
-    let valid = Checkpoint::load(&Path::new(CORPUS).join("checkpoint/valid-3x2.ckpt")).unwrap();
+    // A valid file written field by field (not by `Checkpoint::encode`) loads exactly.
+    let dir = TempDir::new("valid-ckpt");
+    let path = dir.write("valid-3x2.ckpt", &crate::harness::raw_checkpoint(3, 2, 16, 12.5, 6));
+    let valid = Checkpoint::load(&path).unwrap();
     assert_eq!((valid.film.width, valid.film.height, valid.film.samples, valid.seed), (3, 2, 16, 7));
     assert_eq!(valid.stats.elapsed, Duration::from_secs_f64(12.5));
+    assert_eq!(valid.options, crate::harness::RAW_OPTIONS);
+    let mut future = crate::harness::raw_checkpoint(1, 1, 1, 0.0, 1);
+    future[8..12].copy_from_slice(&9u32.to_le_bytes());
+    let future = dir.write("future.ckpt", &crate::harness::with_checksum(&future[..future.len() - 8]));
+    let message = Checkpoint::load(&future).unwrap_err().to_string();
+    assert!(message.contains("unsupported version 9"), "{message}");
 }
 
 /// A checkpoint with a valid checksum whose elapsed time (1e20 s) is finite but does not fit a

@@ -193,10 +193,14 @@ fn resuming_with_other_inputs_or_a_broken_file_is_refused() {
     let mcguire = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/corpus/seeds/CornellBox-Original.obj");
     let cases: [(&[&str], &str); 4] = [
         (&["render", mcguire, "--mode", "ao", "--samples", "4", "--spp", "4", "--size", "32x24"], "different scene"),
-        (&["render", "--mode", "ao", "--samples", "8", "--spp", "4", "--size", "32x24"], "different options"),
+        // A refusal names the option that differs, with both values.
+        (
+            &["render", "--mode", "ao", "--samples", "8", "--spp", "4", "--size", "32x24"],
+            "other options: technique (checkpoint: AmbientOcclusion(AmbientOcclusion { samples: 4",
+        ),
         (
             &["render", "--mode", "ao", "--samples", "4", "--spp", "4", "--size", "32x24", "--seed", "9"],
-            "different options",
+            "other options: seed (checkpoint: 0; now: 9)",
         ),
         (
             &[

@@ -3,8 +3,10 @@
 //!
 //! Layout (little-endian): magic `LUMCKPT1`, u32 version, u64 scene and options fingerprints, u32
 //! width, height and samples per pixel, u64 seed, rays and discarded samples, f64 elapsed seconds,
-//! then per pixel four f64 (radiance sums and luminance second moment), then a u64 hash of all the
-//! preceding bytes. Files are written atomically; a truncated or altered file is refused.
+//! then per pixel four f64 (radiance sums and luminance second moment), then (since version 2) the
+//! options as readable text (u32 length, UTF-8 `key: value` lines, see
+//! [`super::fingerprint::options_description`]), then a u64 hash of all the preceding bytes. Files
+//! are written atomically; a truncated or altered file is refused.
 
 use std::path::Path;
 use std::time::Duration;
@@ -16,15 +18,19 @@ use crate::util::hash::hash_bytes;
 use crate::util::write::write_atomically;
 
 const MAGIC: &[u8; 8] = b"LUMCKPT1";
-const VERSION: u32 = 1;
+const VERSION: u32 = 2;
+/// The longest options text a checkpoint may carry (a sanity bound for hostile files).
+const MAX_OPTIONS_BYTES: usize = 1 << 16;
 const HEADER_BYTES: usize = 8 + 4 + 8 + 8 + 4 + 4 + 4 + 8 + 8 + 8 + 8;
 
-/// A saved render: its film, totals, and the fingerprints of what it was rendered from.
+/// A saved render: its film, totals, and what it was rendered from.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Checkpoint {
     pub scene_fingerprint: u64,
     pub options_fingerprint: u64,
     pub seed: u64,
+    /// The options as readable `key: value` lines, whose hash is `options_fingerprint`.
+    pub options: String,
     pub film: Film,
     pub stats: RenderStats,
 }
@@ -32,7 +38,7 @@ pub struct Checkpoint {
 impl Checkpoint {
     pub fn encode(&self) -> Vec<u8> {
         let film = &self.film;
-        let mut out = Vec::with_capacity(HEADER_BYTES + film.pixel_count() * 32 + 8);
+        let mut out = Vec::with_capacity(HEADER_BYTES + film.pixel_count() * 32 + 4 + self.options.len() + 8);
         out.extend_from_slice(MAGIC);
         out.extend_from_slice(&VERSION.to_le_bytes());
         out.extend_from_slice(&self.scene_fingerprint.to_le_bytes());
@@ -49,6 +55,8 @@ impl Checkpoint {
                 out.extend_from_slice(&v.to_le_bytes());
             }
         }
+        out.extend_from_slice(&(self.options.len() as u32).to_le_bytes());
+        out.extend_from_slice(self.options.as_bytes());
         let hash = hash_bytes(&out);
         out.extend_from_slice(&hash.to_le_bytes());
         out
@@ -74,8 +82,10 @@ impl Checkpoint {
             return Err(bad("truncated or corrupted: its checksum does not match"));
         }
         let mut reader = Reader { bytes: &body[8..] };
-        if reader.u32() != VERSION {
-            return Err(bad("unsupported version"));
+        match reader.u32() {
+            VERSION => {}
+            1 => return Err(bad("version 1, written by an older lumiere; render it again")),
+            other => return Err(bad(&format!("unsupported version {other}"))),
         }
         let (scene_fingerprint, options_fingerprint) = (reader.u64(), reader.u64());
         let (width, height, samples) = (reader.u32(), reader.u32(), reader.u32());
@@ -83,9 +93,20 @@ impl Checkpoint {
         let elapsed = reader.f64();
         // In u128: width * height * 32 overflows u64 for the largest u32 sizes.
         let pixels = width as u128 * height as u128;
-        if width == 0 || height == 0 || reader.bytes.len() as u128 != pixels * 32 {
+        let pixel_bytes = pixels * 32;
+        if width == 0 || height == 0 || (reader.bytes.len() as u128) < pixel_bytes + 4 {
             return Err(bad("its size does not match its pixel data"));
         }
+        let (pixel_data, text) = reader.bytes.split_at(pixel_bytes as usize);
+        let (length, text) = text.split_at(4);
+        let length = u32::from_le_bytes(length.try_into().unwrap_or_default()) as usize;
+        if length != text.len() || length > MAX_OPTIONS_BYTES {
+            return Err(bad("its size does not match its pixel data"));
+        }
+        let Ok(options) = String::from_utf8(text.to_vec()) else {
+            return Err(bad("its options are not text"));
+        };
+        reader.bytes = pixel_data;
         let Ok(elapsed) = Duration::try_from_secs_f64(elapsed) else {
             return Err(bad("invalid elapsed time"));
         };
@@ -97,7 +118,7 @@ impl Checkpoint {
         film.samples = samples;
         film.discarded = discarded;
         let stats = RenderStats { rays, elapsed };
-        Ok(Checkpoint { scene_fingerprint, options_fingerprint, seed, film, stats })
+        Ok(Checkpoint { scene_fingerprint, options_fingerprint, seed, options, film, stats })
     }
 }
 
@@ -123,4 +144,24 @@ impl Reader<'_> {
     fn f64(&mut self) -> f64 {
         f64::from_le_bytes(self.take())
     }
+}
+
+/// The lines of two option descriptions that differ, as `key (checkpoint: …; now: …)`, in the
+/// order of the current description.
+pub fn differing_options(saved: &str, now: &str) -> Vec<String> {
+    let parse = |text: &str| -> Vec<(String, String)> {
+        text.lines().filter_map(|l| l.split_once(": ")).map(|(k, v)| (k.to_string(), v.to_string())).collect()
+    };
+    let (saved, now) = (parse(saved), parse(now));
+    let value = |list: &[(String, String)], key: &str| {
+        list.iter().find(|(k, _)| k == key).map_or("(none)".to_string(), |(_, v)| v.clone())
+    };
+    let mut keys: Vec<&str> = now.iter().map(|(k, _)| k.as_str()).collect();
+    keys.extend(saved.iter().map(|(k, _)| k.as_str()).filter(|k| !now.iter().any(|(n, _)| n == k)));
+    keys.into_iter()
+        .filter_map(|key| {
+            let (a, b) = (value(&saved, key), value(&now, key));
+            (a != b).then(|| format!("{key} (checkpoint: {a}; now: {b})"))
+        })
+        .collect()
 }

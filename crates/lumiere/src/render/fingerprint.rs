@@ -27,12 +27,20 @@ pub fn scene_fingerprint(scene: &Scene) -> u64 {
     h.finish()
 }
 
-/// Everything that decides a sample's value: the technique and its options, seed, sampler, camera
-/// and image size. Not the target spp nor the budgets, which a resumed render may change.
-pub fn options_fingerprint(options: &RenderOptions, camera: &Camera) -> u64 {
-    let mut h = StableHasher::default();
+/// Everything that decides a sample's value, as readable `key: value` lines: the technique and its
+/// options, seed, sampler, pixel sampling, camera and image size. Not the target spp nor the
+/// budgets, which a resumed render may change. Checkpoints store it, so that a refused resume can
+/// name what differs.
+pub fn options_description(options: &RenderOptions, camera: &Camera) -> String {
     // Debug output of these plain records is exact (floats print in shortest round-trip form).
-    let described = format!("{:?} {} {:?} {camera:?}", options.technique, options.seed, options.sampler);
-    h.write(described.as_bytes());
-    h.finish()
+    let pixels = if options.samples_pixel_centres() { "centres (--spp 1)" } else { "jittered (--spp above 1)" };
+    format!(
+        "technique: {:?}\nseed: {}\nsampler: {:?}\npixel positions: {pixels}\ncamera: {camera:?}\n",
+        options.technique, options.seed, options.sampler
+    )
+}
+
+/// The fingerprint of [`options_description`].
+pub fn options_fingerprint(options: &RenderOptions, camera: &Camera) -> u64 {
+    crate::util::hash::hash_bytes(options_description(options, camera).as_bytes())
 }

@@ -5,19 +5,20 @@ use std::path::Path;
 
 use lumiere::render::RenderOptions;
 use lumiere::render::RenderStats;
-use lumiere::render::checkpoint::Checkpoint;
+use lumiere::render::checkpoint::{Checkpoint, differing_options};
 use lumiere::render::film::Film;
-use lumiere::render::fingerprint::{options_fingerprint, scene_fingerprint};
+use lumiere::render::fingerprint::{options_description, scene_fingerprint};
 use lumiere::scene::Scene;
 use lumiere::scene::camera::Camera;
+use lumiere::util::hash::hash_bytes;
 use lumiere::{Error, Result};
 
-/// What a checkpoint must match to be resumed: the scene, the options that decide sample values,
-/// and the seed.
-#[derive(Clone, Copy, Debug)]
+/// What a checkpoint must match to be resumed: the scene, and the options that decide sample
+/// values (seed included), kept as readable text so that a refusal can name what differs.
+#[derive(Clone, Debug)]
 pub struct Fingerprints {
     scene: u64,
-    options: u64,
+    options: String,
     seed: u64,
 }
 
@@ -25,7 +26,7 @@ impl Fingerprints {
     pub fn new(scene: &Scene, options: &RenderOptions, camera: &Camera) -> Fingerprints {
         Fingerprints {
             scene: scene_fingerprint(scene),
-            options: options_fingerprint(options, camera),
+            options: options_description(options, camera),
             seed: options.seed,
         }
     }
@@ -47,10 +48,12 @@ impl Fingerprints {
                 path.display()
             )));
         }
-        if checkpoint.options_fingerprint != self.options || checkpoint.seed != self.seed {
+        if checkpoint.options_fingerprint != hash_bytes(self.options.as_bytes()) || checkpoint.seed != self.seed {
+            let differing = differing_options(&checkpoint.options, &self.options);
             return Err(Error::invalid(format!(
-                "{}: cannot resume: the checkpoint was rendered with different options (mode, --samples, --seed, --sampler, --light-sampling, --ao-distance, camera or --size); only --spp and the budgets may change",
-                path.display()
+                "{}: cannot resume: the checkpoint was rendered with other options: {}; only --spp and the budgets may change",
+                path.display(),
+                differing.join(", ")
             )));
         }
         Ok((checkpoint.film, checkpoint.stats))
@@ -59,8 +62,9 @@ impl Fingerprints {
     pub fn save(&self, path: &Path, film: &Film, stats: &RenderStats) -> Result<()> {
         let checkpoint = Checkpoint {
             scene_fingerprint: self.scene,
-            options_fingerprint: self.options,
+            options_fingerprint: hash_bytes(self.options.as_bytes()),
             seed: self.seed,
+            options: self.options.clone(),
             film: film.clone(),
             stats: *stats,
         };
