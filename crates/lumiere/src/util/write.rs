@@ -22,6 +22,8 @@ static IN_FLIGHT: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 /// Writes `bytes` to `path` atomically. Refuses a `path` that exists and is not a regular file (a
 /// device, a FIFO): renaming over it would replace the node itself, `/dev/null` included.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
+    let resolved = resolve_link(path)?;
+    let path = resolved.as_deref().unwrap_or(path);
     check_target(path)?;
     let temp = temp_path(path)?;
     // Created separately so that a failure here (missing directory, no permission) leaves nothing to
@@ -39,6 +41,8 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
 
 /// Checks that a file can be created at `path` (any extension) without touching `path` itself.
 pub fn check_writable(path: &Path) -> Result<()> {
+    let resolved = resolve_link(path)?;
+    let path = resolved.as_deref().unwrap_or(path);
     check_target(path)?;
     let probe = temp_path(path)?;
     create_new(&probe).map_err(|e| Error::io(path, e))?;
@@ -81,6 +85,23 @@ fn temp_owner(name: &str) -> Option<u32> {
     let (pid, n) = middle.split_once('-')?;
     n.parse::<u64>().ok()?;
     pid.parse().ok()
+}
+
+/// Where a symbolic link points: the file to replace is its target, never the link itself (a
+/// rename over `/dev/stdout` would replace the link). `None` when `path` is not a link; an error
+/// when it leads nowhere that can be named (a dangling link, or a pipe behind `/dev/stdout`).
+fn resolve_link(path: &Path) -> Result<Option<PathBuf>> {
+    let is_link = fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink());
+    if !is_link {
+        return Ok(None);
+    }
+    match fs::canonicalize(path) {
+        Ok(target) => Ok(Some(target)),
+        Err(_) => Err(Error::invalid(format!(
+            "{}: is a link to nothing lumiere can replace (dangling, or a pipe or device); give a file name",
+            path.display()
+        ))),
+    }
 }
 
 /// Refuses a target that exists and is not a regular file (or a link to one), and a directory.

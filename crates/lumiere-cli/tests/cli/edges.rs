@@ -1,0 +1,308 @@
+//! Trust at the edges (docs/RELIABILITY.md): closed and full streams, budgets and signals inside a
+//! costly pass, outputs that would clobber inputs or each other, flags that are out of range or do
+//! nothing, and images that come out black. Every case runs the binary as a user would.
+
+use std::fs;
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+use crate::common::TempDir;
+
+fn lumiere() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_lumiere"))
+}
+
+fn run(args: &[&str]) -> Output {
+    lumiere().args(args).output().expect("the binary runs")
+}
+
+fn stderr(output: &Output) -> String {
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+/// A scene with a material library that does not exist: loading it warns.
+fn scene_with_a_warning(dir: &TempDir) -> String {
+    dir.write("warn.obj", "mtllib missing.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    dir.arg("warn.obj")
+}
+
+// ---------------------------------------------------------------------------------------------
+// Closed and full streams
+
+#[test]
+fn a_closed_stdout_ends_the_command_quietly() {
+    let dir = TempDir::new("closed-stdout");
+    let scene = scene_with_a_warning(&dir);
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let out = lumiere().args(["info", &scene]).stdout(writer).stderr(Stdio::piped()).output().unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    assert!(!stderr(&out).contains("panicked"), "{}", stderr(&out));
+}
+
+#[test]
+fn a_full_stdout_is_an_error_not_a_panic() {
+    let dir = TempDir::new("full-stdout");
+    let scene = scene_with_a_warning(&dir);
+    let full = fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
+    let out = lumiere().args(["info", &scene]).stdout(full).stderr(Stdio::piped()).output().unwrap();
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("<stdout>: No space left on device"), "{}", stderr(&out));
+}
+
+/// Warnings that meet a closed stderr (`2>&1 | head`) must not cost the render.
+#[test]
+fn a_closed_stderr_does_not_lose_the_render() {
+    let dir = TempDir::new("closed-stderr");
+    let scene = scene_with_a_warning(&dir);
+    let image = dir.arg("out.png");
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let status = lumiere()
+        .args(["render", &scene, "--size", "16x12", "--mode", "hits", "-o", &image])
+        .stderr(writer)
+        .status()
+        .unwrap();
+    assert_eq!(status.code(), Some(0));
+    assert!(fs::metadata(&image).unwrap().len() > 0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Budgets and signals inside a pass
+
+/// Two million shadow rays per light per pixel: one pass would take minutes. The budget stops it
+/// within the pixel, and the message says why the image is black.
+#[test]
+fn the_time_budget_stops_inside_a_costly_pass() {
+    let dir = TempDir::new("costly-budget");
+    let start = Instant::now();
+    let out = run(&[
+        "render",
+        "--mode",
+        "direct",
+        "--samples",
+        "2000000",
+        "--size",
+        "64x48",
+        "--time",
+        "300ms",
+        "-o",
+        &dir.arg("o.png"),
+    ]);
+    let took = start.elapsed();
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    assert!(took < Duration::from_secs(5), "took {took:?}");
+    let message = stderr(&out);
+    assert!(message.contains("time budget reached after 0 of"), "{message}");
+    assert!(message.contains("before the first pass completed"), "{message}");
+}
+
+#[test]
+fn ctrl_c_stops_inside_a_costly_pass() {
+    let dir = TempDir::new("costly-signal");
+    let child = lumiere()
+        .args(["render", "--mode", "ao", "--samples", "5000000", "--size", "64x48", "-o", &dir.arg("o.png")])
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(500));
+    let sent = Instant::now();
+    let status = Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap();
+    assert!(status.success());
+    let out = child.wait_with_output().unwrap();
+    assert!(sent.elapsed() < Duration::from_secs(5), "took {:?} to stop", sent.elapsed());
+    assert_eq!(out.status.code(), Some(3), "{}", stderr(&out));
+    assert!(stderr(&out).contains("interrupted after 0 of 1 spp"), "{}", stderr(&out));
+}
+
+/// `--time` without `--spp` renders until the budget is met, not one pass.
+#[test]
+fn a_budget_without_spp_renders_until_it_is_met() {
+    let dir = TempDir::new("budget-no-spp");
+    let stats = dir.arg("s.json");
+    let out = run(&[
+        "render",
+        "--mode",
+        "ao",
+        "--samples",
+        "2",
+        "--size",
+        "16x12",
+        "--time",
+        "300ms",
+        "--stats-json",
+        &stats,
+        "-o",
+        &dir.arg("o.png"),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let json: serde_json::Value = serde_json::from_slice(&fs::read(&stats).unwrap()).unwrap();
+    assert!(json["spp"].as_u64().unwrap() > 1, "{json}");
+    assert_eq!(json["stop"], "time budget reached");
+    assert!(stderr(&out).contains("of unlimited spp"), "{}", stderr(&out));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Outputs never clobber
+
+/// Runs a render that must be refused: exit code 2, `expected` in its one-line message, and the
+/// files in `dir` unchanged.
+fn assert_refused(dir: &TempDir, args: &[&str], expected: &str) {
+    let before: Vec<(String, Vec<u8>)> =
+        dir.entries().into_iter().map(|name| (name.clone(), fs::read(dir.path(&name)).unwrap_or_default())).collect();
+    let out = run(args);
+    let message = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {message}");
+    assert!(message.contains(expected), "{args:?}: expected {expected:?} in {message}");
+    assert_eq!(message.trim_end().lines().count(), 1, "{args:?}: not one line: {message}");
+    let after: Vec<(String, Vec<u8>)> =
+        dir.entries().into_iter().map(|name| (name.clone(), fs::read(dir.path(&name)).unwrap_or_default())).collect();
+    assert_eq!(before, after, "{args:?} changed the folder");
+}
+
+#[test]
+fn outputs_that_are_inputs_or_each_other_are_refused() {
+    let dir = TempDir::new("clobber");
+    let scene = dir.write("scene.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    let scene = scene.to_str().unwrap();
+    let out = dir.arg("out.png");
+    let small = ["render", "--size", "8x6"];
+    assert_refused(&dir, &[&small[..], &["-o", &out, "--stats-json", &out]].concat(), "are the same file");
+    assert_refused(
+        &dir,
+        &[&small[..], &[scene, "-o", &out, "--checkpoint", scene]].concat(),
+        "an output would overwrite an input",
+    );
+    // The same file under another name (a relative path with `..`) is caught by device and inode.
+    let other_name = format!("{}/../{}/scene.obj", dir.0.display(), dir.0.file_name().unwrap().to_string_lossy());
+    assert_refused(&dir, &[&small[..], &[scene, "-o", &out, "--stats-json", &other_name]].concat(), "same file");
+    for device in ["/dev/null", "/dev/stdout"] {
+        assert_refused(&dir, &[&small[..], &["-o", &out, "--checkpoint", device]].concat(), "not a regular file");
+    }
+    assert_refused(&dir, &[&small[..], &["-o", &dir.arg("out")]].concat(), "has no extension");
+}
+
+#[test]
+fn stats_go_to_stdout_with_a_dash() {
+    let dir = TempDir::new("stats-stdout");
+    let out = run(&["render", "--size", "8x6", "--mode", "hits", "--stats-json", "-", "-o", &dir.arg("o.png")]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["mode"], "hits");
+    assert_eq!(dir.entries(), ["o.png"]);
+}
+
+/// A legal output name of 250 bytes still gets its temporary file, which is then gone.
+#[test]
+fn long_output_names_are_written() {
+    let dir = TempDir::new("long-name");
+    let name = format!("{}.png", "a".repeat(246));
+    let out = run(&["render", "--size", "8x6", "--mode", "hits", "-o", &dir.arg(&name)]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(dir.entries(), [name]);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Flags
+
+#[test]
+fn numeric_flags_out_of_range_are_refused() {
+    let cases: [(&[&str], &str); 11] = [
+        (&["--fov", "0"], "between 0 and 180"),
+        (&["--fov", "1e40"], "between 0 and 180"),
+        (&["--fov", "nan"], "finite"),
+        (&["--threads", "10000"], "at most 1024 threads"),
+        (&["--time", "-1s"], "positive"),
+        (&["--time", "1e3x"], "expected a duration"),
+        (&["--preview-every", "nan"], "finite"),
+        (&["--preview-every", "-2"], "positive"),
+        (&["--checkpoint-every", "-1"], "must not be negative"),
+        (&["--noise", "0"], "positive"),
+        (&["--eye", "1e38,0,0", "--target", "-3e38,0,0"], "too far apart"),
+    ];
+    let dir = TempDir::new("flags");
+    for (flags, expected) in cases {
+        let out = run(&[&["render", "--size", "8x6", "-o", &dir.arg("o.png")][..], flags].concat());
+        assert_eq!(out.status.code(), Some(2), "{flags:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains(expected), "{flags:?}: expected {expected:?} in {}", stderr(&out));
+        assert!(dir.entries().is_empty(), "{flags:?} wrote a file");
+    }
+    // An exponent in a duration is a number, not a unit.
+    let out =
+        run(&["render", "--size", "8x6", "--mode", "hits", "--time", "1e3s", "--spp", "1", "-o", &dir.arg("o.png")]);
+    assert!(out.status.success(), "{}", stderr(&out));
+}
+
+#[test]
+fn flags_that_do_nothing_are_warned() {
+    let dir = TempDir::new("ignored");
+    let out = run(&[
+        "render",
+        "--size",
+        "8x6",
+        "--mode",
+        "hits",
+        "--samples",
+        "4",
+        "--ao-distance",
+        "2",
+        "--light-sampling",
+        "power",
+        "--fov",
+        "30",
+        "-o",
+        &dir.arg("o.png"),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let message = stderr(&out);
+    for flag in ["--samples", "--ao-distance", "--light-sampling", "--fov"] {
+        assert!(message.contains(&format!("warning: {flag} has no effect")), "{flag}: {message}");
+    }
+}
+
+/// A render of one sample per pixel centre cannot be continued with jittered samples: the
+/// refusal says so instead of silently mixing the two.
+#[test]
+fn a_one_sample_checkpoint_is_not_continued_with_more() {
+    let dir = TempDir::new("spp1");
+    let checkpoint = dir.arg("c.ckpt");
+    let base = ["render", "--size", "8x6", "--mode", "ao", "--samples", "2"];
+    let out = run(&[&base[..], &["--spp", "1", "--checkpoint", &checkpoint, "-o", &dir.arg("a.png")]].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = run(&[&base[..], &["--spp", "4", "--resume", &checkpoint, "-o", &dir.arg("b.png")]].concat());
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("pixel positions (checkpoint: centres (--spp 1)"), "{}", stderr(&out));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Black images explain themselves
+
+#[test]
+fn a_scene_without_emitters_says_why_it_is_black() {
+    let dir = TempDir::new("unlit");
+    let scene = dir.write("unlit.obj", "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n");
+    let out = run(&["render", scene.to_str().unwrap(), "--size", "8x6", "-o", &dir.arg("o.png")]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("the scene has no emitters"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("--emission"), "{}", stderr(&out));
+}
+
+#[test]
+fn a_camera_that_sees_nothing_says_so() {
+    let dir = TempDir::new("looks-away");
+    let out = run(&[
+        "render",
+        "--size",
+        "8x6",
+        "--mode",
+        "hits",
+        "--eye",
+        "0,1,3",
+        "--target",
+        "0,1,10",
+        "-o",
+        &dir.arg("o.png"),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("the image is black"), "{}", stderr(&out));
+}
