@@ -88,8 +88,8 @@ pub struct BenchBvhArgs {
 
 #[derive(Args, Debug)]
 pub struct InfoArgs {
-    /// Wavefront OBJ file (.obj or .obj.gz) with its MTL files.
-    pub scene: PathBuf,
+    /// Wavefront OBJ file (.obj or .obj.gz) with its MTL files; the built-in scene when omitted.
+    pub scene: Option<PathBuf>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]

@@ -1,9 +1,14 @@
+//! `lumiere info`: what is in a scene — counts, materials by name (what `--emission` needs), their
+//! textures, lights, bounds — and its load warnings.
+
+use std::fmt::Display;
 use std::time::Instant;
 
 use glam::Vec3;
 
 use lumiere::Result;
 use lumiere::lights::LightSet;
+use lumiere::materials::Material;
 use lumiere::scene::Scene;
 
 use super::args::InfoArgs;
@@ -11,35 +16,66 @@ use super::output;
 
 pub fn run(args: &InfoArgs) -> Result<()> {
     let start = Instant::now();
-    let scene = Scene::load(&args.scene)?;
+    let scene = match &args.scene {
+        Some(path) => Scene::load(path)?,
+        None => Scene::builtin()?,
+    };
     let load_ms = start.elapsed().as_secs_f64() * 1e3;
     for warning in &scene.warnings {
-        output::warn(format_args!("{warning}"));
+        output::warn(warning);
     }
-    let bounds = scene.bounds();
     let lights = LightSet::new(&scene);
     let lights = lights.lights();
-    let light_area: f32 = lights.iter().map(|l| l.area).sum();
-    let light_power: Vec3 = lights.iter().map(|l| l.power()).sum();
-    output::print(format_args!("scene      {}", scene.name))?;
-    output::print(format_args!("triangles  {}", scene.mesh.triangle_count()))?;
-    output::print(format_args!("vertices   {}", scene.mesh.positions.len()))?;
-    output::print(format_args!("materials  {}", scene.materials.len()))?;
-    output::print(format_args!(
-        "lights     {} triangles, area {light_area:.6}, power {:.6} {:.6} {:.6} W",
-        lights.len(),
-        light_power.x,
-        light_power.y,
-        light_power.z
-    ))?;
+    let light_area: f32 = lights.iter().map(|l| l.area).fold(0.0, |a, b| a + b);
+    let light_power: Vec3 = lights.iter().map(|l| l.power()).fold(Vec3::ZERO, |a, b| a + b);
+    line("scene", &scene.name)?;
+    line("triangles", scene.mesh.triangle_count())?;
+    line("vertices", scene.mesh.positions.len())?;
+    line("normals", if scene.mesh.normal_indices.is_empty() { "none" } else { "per vertex (vn)" })?;
+    line("texcoords", if scene.mesh.texcoord_indices.is_empty() { "none" } else { "per vertex (vt)" })?;
+    line(
+        "lights",
+        format!("{} triangles, area {}, power {} W", lights.len(), number(light_area), vector(light_power)),
+    )?;
+    let bounds = scene.bounds();
     if bounds.is_empty() {
-        output::print(format_args!("bounds     empty"))?;
+        line("bounds", "empty")?;
     } else {
-        output::print(format_args!(
-            "bounds     ({:.6}, {:.6}, {:.6}) .. ({:.6}, {:.6}, {:.6})",
-            bounds.min.x, bounds.min.y, bounds.min.z, bounds.max.x, bounds.max.y, bounds.max.z
-        ))?;
+        line("bounds", format!("{} .. {}", vector(bounds.min), vector(bounds.max)))?;
     }
-    output::print(format_args!("load       {load_ms:.1} ms"))?;
+    line("load", format!("{load_ms:.1} ms"))?;
+    line("materials", scene.materials.len())?;
+    let mut triangles = vec![0usize; scene.materials.len()];
+    for &id in &scene.mesh.material_ids {
+        triangles[id as usize] += 1;
+    }
+    for (material, triangles) in scene.materials.iter().zip(triangles) {
+        output::print(format_args!("  {:?}: {triangles} triangles, {}", material.name, describe(material)))?;
+    }
     Ok(())
+}
+
+fn line(key: &str, value: impl Display) -> Result<()> {
+    output::print(format_args!("{key:<11}{value}"))
+}
+
+/// What lumiere uses of a material: its colour, its texture, its emission.
+fn describe(material: &Material) -> String {
+    let mut parts = vec![format!("Kd {}", vector(material.kd))];
+    if let Some(texture) = &material.map_kd {
+        parts.push(format!("map_Kd {:?}", texture.display().to_string()));
+    }
+    if material.is_emissive() {
+        parts.push(format!("Ke {} (a light)", vector(material.ke)));
+    }
+    parts.join(", ")
+}
+
+/// Six decimals, and `0` never printed as `-0`.
+fn number(x: f32) -> String {
+    format!("{:.6}", if x == 0.0 { 0.0 } else { x })
+}
+
+fn vector(v: Vec3) -> String {
+    format!("({}, {}, {})", number(v.x), number(v.y), number(v.z))
 }

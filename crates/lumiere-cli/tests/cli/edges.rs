@@ -307,3 +307,43 @@ fn a_camera_that_sees_nothing_says_so() {
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(stderr(&out).contains("the image is black"), "{}", stderr(&out));
 }
+
+/// A signal while a large scene loads exits at once with the documented code, writing nothing.
+#[test]
+fn ctrl_c_while_loading_exits_3_and_writes_nothing() {
+    let dir = TempDir::new("signal-load");
+    // Three million faces in 35 KB of gzip: loading and building take about half a second.
+    let mut text = String::from("v 0 0 0\nv 1 0 0\nv 0 1 0\n");
+    text.push_str(&"f 1 2 3\n".repeat(3_000_000));
+    let mut gz = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+    std::io::Write::write_all(&mut gz, text.as_bytes()).unwrap();
+    let scene = dir.write("big.obj.gz", gz.finish().unwrap());
+    let child = lumiere()
+        .args(["render", scene.to_str().unwrap(), "--size", "8x6", "-o", &dir.arg("o.png")])
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(150));
+    assert!(Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap().success());
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(3), "{}", stderr(&out));
+    assert!(stderr(&out).contains("interrupted while loading"), "{}", stderr(&out));
+    assert_eq!(dir.entries(), ["big.obj.gz"]);
+}
+
+/// `info` works on the built-in scene, names every material (what `--emission` needs) with its
+/// triangle count, and never prints a negative zero.
+#[test]
+fn info_names_materials_and_prints_no_negative_zero() {
+    let out = run(&["info"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("\"light.001\": 2 triangles") && text.contains("(a light)"), "{text}");
+    assert!(text.contains("materials  8"), "{text}");
+    let dir = TempDir::new("info-unlit");
+    let scene = dir.write("unlit.obj", "v 0 0 0\nv -1 0 0\nv 0 -1 0\nf 1 2 3\n");
+    let out = run(&["info", scene.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("lights     0 triangles, area 0.000000"), "{text}");
+    assert!(!text.contains("-0.000000"), "{text}");
+}

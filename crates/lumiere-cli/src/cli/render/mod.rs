@@ -54,6 +54,7 @@ fn render(args: &RenderArgs, threads: usize) -> Result<u8> {
     let timings = Timings { load_ms, build_ms: build_start.elapsed().as_secs_f64() * 1e3 };
 
     report::warn_if_unlit(&world, &options);
+    signals::rendering_starts();
     let output = render_passes(args, &world, &camera, &options, &fingerprints, film, stats)?;
     report::warn_if_black(&output);
     write_image(&args.output, output.image.width, output.image.height, &output.image.pixels, png_encoding(args))?;

@@ -1,21 +1,32 @@
-//! SIGINT and SIGTERM: the first one stops the render cleanly within a pixel (the image of every
-//! completed pass and the checkpoint are written, exit code 3); a second one quits at once, removing
-//! any temporary file in flight. Files are written atomically, so neither leaves a half-written file.
+//! SIGINT and SIGTERM. While the scene loads, nothing is worth saving: a signal exits at once with
+//! code 3. While rendering, the first signal stops the render within a pixel (the image of every
+//! completed pass and the checkpoint are written, exit code 3); a second one quits at once,
+//! removing any temporary file in flight. Files are written atomically, so no case leaves a
+//! half-written file.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
+use super::EXIT_INTERRUPTED;
 use crate::cli::output;
 
-/// Set by the first signal; the render loop watches it.
+/// Set by the first signal while rendering; the render loop watches it.
 pub static CANCEL: AtomicBool = AtomicBool::new(false);
+
+/// True once the render has started: from then on a first signal stops it cleanly.
+static RENDERING: AtomicBool = AtomicBool::new(false);
 
 /// Exit code after a second signal (128 + SIGINT, as a shell reports it).
 const EXIT_AT_ONCE: i32 = 130;
 
-/// Installs the handler. A failure only costs a warning: the render still runs, but an interruption
-/// will lose it.
+/// Installs the handler, before anything slow happens. A failure only costs a warning: the render
+/// still runs, but an interruption will lose it.
 pub fn install() {
     if let Err(e) = ctrlc::set_handler(|| {
+        if !RENDERING.load(Ordering::SeqCst) {
+            output::note("interrupted while loading; nothing was written");
+            lumiere::util::write::remove_in_flight();
+            std::process::exit(i32::from(EXIT_INTERRUPTED));
+        }
         if CANCEL.swap(true, Ordering::SeqCst) {
             // An image or checkpoint may be half-written to its temporary file: remove it first.
             lumiere::util::write::remove_in_flight();
@@ -24,4 +35,9 @@ pub fn install() {
     }) {
         output::warn(format_args!("cannot catch Ctrl-C ({e}); an interruption will lose the render"));
     }
+}
+
+/// From now on a first signal stops the render cleanly instead of exiting.
+pub fn rendering_starts() {
+    RENDERING.store(true, Ordering::SeqCst);
 }
