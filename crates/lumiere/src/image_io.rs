@@ -9,7 +9,6 @@ use std::path::Path;
 use std::sync::OnceLock;
 
 use glam::Vec3;
-use image::{ExtendedColorType, ImageEncoder};
 
 use crate::error::{Error, Result};
 use crate::util::write::{check_writable, write_atomically};
@@ -22,6 +21,46 @@ pub enum PngEncoding {
     Srgb,
     /// gKit's convention: floor(255 * clamp(c, 0, 1)), no gamma, for side-by-side comparisons with gKit renders.
     GkitLinear,
+}
+
+/// How PNG maps radiance above 1 into the displayable range (EXR and PFM keep linear values).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Tonemap {
+    /// Clip each channel to `[0, 1]`: the lab's images, exact for values already in range.
+    #[default]
+    Clamp,
+    /// A filmic curve: Narkowicz's 2015 fit of the ACES reference rendering transform, applied per
+    /// channel to `0.6 × exposed radiance` (the scale of his fit); highlights roll off smoothly
+    /// instead of clipping.
+    Aces,
+}
+
+impl Tonemap {
+    #[inline]
+    fn apply(self, c: f32) -> f32 {
+        match self {
+            Tonemap::Clamp => c,
+            Tonemap::Aces => {
+                let x = 0.6 * c.max(0.0);
+                (x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14)).clamp(0.0, 1.0)
+            }
+        }
+    }
+}
+
+/// What a PNG shows of linear radiance: `radiance × 2^exposure`, tone mapped, then encoded.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct PngStyle {
+    pub encoding: PngEncoding,
+    /// Exposure in stops (EV): each +1 doubles the radiance before tone mapping.
+    pub exposure: f32,
+    pub tonemap: Tonemap,
+}
+
+impl From<PngEncoding> for PngStyle {
+    fn from(encoding: PngEncoding) -> Self {
+        PngStyle { encoding, ..PngStyle::default() }
+    }
 }
 
 /// The file formats we write, chosen by extension.
@@ -41,11 +80,11 @@ const SUPPORTED: &str = ".png, .exr, .pfm";
 /// supported ones. The file appears atomically: bytes go to a temporary file in the same directory, which
 /// is renamed over `path` only after a complete write (and fsync of the file); on any failure the temporary
 /// file is removed and `path` is untouched.
-pub fn write_image(path: &Path, width: u32, height: u32, pixels: &[Vec3], png: PngEncoding) -> Result<()> {
+pub fn write_image(path: &Path, width: u32, height: u32, pixels: &[Vec3], png: impl Into<PngStyle>) -> Result<()> {
     let format = format_of(path)?;
     check_dimensions(width, height, pixels.len())?;
     let bytes = match format {
-        Format::Png => encode_png(path, width, height, pixels, png)?,
+        Format::Png => encode_png(path, width, height, pixels, png.into())?,
         Format::Exr => encode_exr(path, width, height, pixels)?,
         Format::Pfm => encode_pfm(width, height, pixels),
     };
@@ -167,16 +206,27 @@ fn check_dimensions(width: u32, height: u32, len: usize) -> Result<()> {
     Ok(())
 }
 
-fn encode_png(path: &Path, width: u32, height: u32, pixels: &[Vec3], encoding: PngEncoding) -> Result<Vec<u8>> {
-    let encode: fn(f32) -> u8 = match encoding {
+fn encode_png(path: &Path, width: u32, height: u32, pixels: &[Vec3], style: PngStyle) -> Result<Vec<u8>> {
+    let encode: fn(f32) -> u8 = match style.encoding {
         PngEncoding::Srgb => linear_to_srgb8,
         PngEncoding::GkitLinear => gkit_linear8,
     };
-    let raw: Vec<u8> = pixels.iter().flat_map(|p| p.to_array().map(encode)).collect();
+    let scale = style.exposure.exp2();
+    let map = |c: f32| encode(style.tonemap.apply(if style.exposure == 0.0 { c } else { c * scale }));
+    let raw: Vec<u8> = pixels.iter().flat_map(|p| p.to_array().map(map)).collect();
     let mut bytes = Vec::new();
-    image::codecs::png::PngEncoder::new(&mut bytes)
-        .write_image(&raw, width, height, ExtendedColorType::Rgb8)
-        .map_err(|e| Error::invalid(format!("{}: cannot encode PNG: {e}", path.display())))?;
+    let mut encoder = png::Encoder::new(&mut bytes, width, height);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    // The sRGB chunk tells viewers how to show the values; gKit's linear bytes get none, since they
+    // are not sRGB-encoded.
+    if style.encoding == PngEncoding::Srgb {
+        encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+    }
+    let failed = |e: png::EncodingError| Error::invalid(format!("{}: cannot encode PNG: {e}", path.display()));
+    let mut writer = encoder.write_header().map_err(failed)?;
+    writer.write_image_data(&raw).map_err(failed)?;
+    writer.finish().map_err(failed)?;
     Ok(bytes)
 }
 

@@ -58,6 +58,15 @@ impl World {
         self.scene.material(id)
     }
 
+    /// Radiance emitted by triangle `id` along `ray` back towards its origin: the emission of a
+    /// light seen from the side its winding faces, nothing from behind or from a non-light.
+    #[inline]
+    pub fn emitted(&self, triangle: u32, ray: &Ray) -> Vec3 {
+        self.lights
+            .light_of(triangle)
+            .map_or(Vec3::ZERO, |index| self.lights.lights()[index as usize].radiance_towards(-ray.dir))
+    }
+
     /// The closest hit along `ray` within `[0, ray.tmax]`.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {

@@ -13,7 +13,7 @@ pub struct Cli {
 #[derive(Subcommand, Debug)]
 pub enum Command {
     /// Render a scene (gKit's Cornell box when no scene is given) to an image.
-    Render(RenderArgs),
+    Render(Box<RenderArgs>),
     /// Print a scene's triangles, materials, lights, bounds and load time.
     Info(InfoArgs),
     /// Measure BVH build and traversal on the benchmark scenes (Markdown tables on stdout).
@@ -104,6 +104,16 @@ pub enum ModeArg {
     Direct,
     /// Ambient occlusion: fraction of --samples cosine-weighted directions that see the sky.
     Ao,
+    /// Global illumination: path tracing with next-event estimation and MIS (see --max-depth).
+    Path,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum TonemapArg {
+    /// Clip each channel at 1.
+    Clamp,
+    /// Narkowicz's fit of the ACES filmic curve: highlights roll off instead of clipping.
+    Aces,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -127,9 +137,15 @@ pub struct RenderArgs {
     /// Wavefront OBJ file (.obj or .obj.gz); the built-in gKit Cornell box when omitted.
     pub scene: Option<PathBuf>,
 
-    /// What to compute per pixel.
-    #[arg(long, value_enum, default_value_t = ModeArg::Shadows)]
+    /// What to compute per pixel: path tracing, or one of the lab's steps.
+    #[arg(long, value_enum, default_value_t = ModeArg::Path)]
     pub mode: ModeArg,
+
+    /// Longest path in segments from the camera, as Mitsuba counts (path only): 1 shows the
+    /// emitters, 2 direct light, 8 up to seven bounces; 0 = no limit (Russian roulette ends paths).
+    /// [default: 8]
+    #[arg(long)]
+    pub max_depth: Option<u32>,
 
     /// Samples per camera sample, for direct and ao only: points on every light triangle (direct),
     /// points in total (direct with --light-sampling power), or directions (ao). A pixel traces
@@ -138,8 +154,8 @@ pub struct RenderArgs {
     pub samples: Option<u32>,
 
     /// Camera samples per pixel, each a pass over the image: 1 is one ray through each pixel centre
-    /// (the lab's images), more are jittered in the pixel. [default: 1, or unlimited with --time
-    /// or --noise: the render goes on until the budget is met]
+    /// (the lab's images), more are jittered in the pixel. [default: 8 for path, 1 for the lab's
+    /// modes, or unlimited with --time or --noise: the render goes on until the budget is met]
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     pub spp: Option<u32>,
 
@@ -200,6 +216,15 @@ pub struct RenderArgs {
     /// Write PNGs as gKit does (floor(255*c), no gamma) for side-by-side comparison with gKit renders.
     #[arg(long)]
     pub png_linear: bool,
+
+    /// Exposure of the PNG in stops: each +1 doubles the brightness (EXR and PFM stay linear).
+    #[arg(long, default_value_t = 0.0, value_parser = parse_exposure, allow_hyphen_values = true)]
+    pub exposure: f32,
+
+    /// How the PNG maps radiance to the display: clamp (clip at 1, the lab's images) or aces (a
+    /// filmic curve). [default: aces for path, clamp for the lab's modes]
+    #[arg(long, value_enum)]
+    pub tonemap: Option<TonemapArg>,
 
     /// Write render statistics (mode, size, rays, timings) as JSON to this file; `-` for stdout.
     #[arg(long)]
@@ -274,6 +299,11 @@ fn parse_non_negative_f64(s: &str) -> Result<f64, String> {
 fn parse_positive_f32(s: &str) -> Result<f32, String> {
     let value = parse_positive_f64(s)? as f32;
     if value.is_finite() && value > 0.0 { Ok(value) } else { Err(format!("out of range, got {s:?}")) }
+}
+
+fn parse_exposure(s: &str) -> Result<f32, String> {
+    let value = parse_finite(s)?;
+    if value.abs() <= 64.0 { Ok(value as f32) } else { Err(format!("an exposure between -64 and 64 stops, got {s:?}")) }
 }
 
 fn parse_fov(s: &str) -> Result<f32, String> {

@@ -109,6 +109,8 @@ fn shadows_mode_lights_the_floor_and_is_black_behind_the_tall_box() {
     let up = dir.path("up.pfm");
     let run = lumiere(&[
         "render",
+        "--mode",
+        "shadows",
         "--size",
         "64x48",
         "--eye",
@@ -128,13 +130,15 @@ fn shadows_mode_lights_the_floor_and_is_black_behind_the_tall_box() {
 #[test]
 fn thread_count_does_not_change_the_bytes() {
     let dir = TempDir::new("threads");
-    let one = dir.path("one.png");
-    let two = dir.path("two.png");
-    for (threads, out) in [("1", &one), ("2", &two)] {
-        let run = lumiere(&["render", "--mode", "shadows", "--threads", threads, "-o", out.to_str().unwrap()]);
-        assert!(run.status.success(), "{}", stderr(&run));
+    for mode in [&["--mode", "shadows"][..], &["--mode", "path", "--spp", "4", "--size", "256x192"]] {
+        let one = dir.path("one.pfm");
+        let two = dir.path("two.pfm");
+        for (threads, out) in [("1", &one), ("2", &two)] {
+            let run = lumiere(&[&["render", "--threads", threads, "-o", out.to_str().unwrap()][..], mode].concat());
+            assert!(run.status.success(), "{}", stderr(&run));
+        }
+        assert_eq!(fs::read(&one).unwrap(), fs::read(&two).unwrap(), "{mode:?}");
     }
-    assert_eq!(fs::read(&one).unwrap(), fs::read(&two).unwrap());
 }
 
 #[test]

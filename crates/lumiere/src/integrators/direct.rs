@@ -63,8 +63,10 @@ impl Integrator for Direct {
         ctx.rays += 1;
         let Some(hit) = world.intersect(ray) else { return Vec3::ZERO };
         let material = world.material(hit.triangle);
-        if material.is_emissive() {
-            return material.ke;
+        // A light seen from the side it faces shows its emission; from behind it is a surface.
+        let emitted = world.emitted(hit.triangle, ray);
+        if emitted != Vec3::ZERO {
+            return emitted;
         }
         let surface = world.surface(ray, &hit);
         let (frame, wo) = shading_frame(surface.ns, ray);

@@ -5,6 +5,7 @@ mod ao;
 mod direct;
 mod hits;
 mod materials;
+mod path;
 mod shadows;
 
 use glam::Vec3;
@@ -19,6 +20,7 @@ pub use ao::AmbientOcclusion;
 pub use direct::{Direct, LightSampling};
 pub use hits::Hits;
 pub use materials::Materials;
+pub use path::{Path, PathStrategy};
 pub use shadows::Shadows;
 
 /// What a render computes per pixel, with the options of that technique.
@@ -34,6 +36,8 @@ pub enum Technique {
     Direct(Direct),
     /// Ambient occlusion with N cosine-weighted directions (lab figures 7-9).
     AmbientOcclusion(AmbientOcclusion),
+    /// Global illumination: path tracing with next-event estimation and MIS.
+    Path(Path),
 }
 
 impl Technique {
@@ -55,6 +59,7 @@ impl Technique {
             Technique::Shadows(_) => "shadows",
             Technique::Direct(_) => "direct",
             Technique::AmbientOcclusion(_) => "ao",
+            Technique::Path(_) => "path",
         }
     }
 

@@ -15,8 +15,10 @@ impl Integrator for Shadows {
         ctx.rays += 1;
         let Some(hit) = world.intersect(ray) else { return Vec3::ZERO };
         let material = world.material(hit.triangle);
-        if material.is_emissive() {
-            return material.ke;
+        // A light seen from the side it faces shows its emission; from behind it is a surface.
+        let emitted = world.emitted(hit.triangle, ray);
+        if emitted != Vec3::ZERO {
+            return emitted;
         }
         let surface = world.surface(ray, &hit);
         let bsdf = material.bsdf();

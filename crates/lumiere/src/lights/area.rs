@@ -34,6 +34,13 @@ impl AreaLight {
         b.x * p0 + b.y * p1 + b.z * p2
     }
 
+    /// Radiance leaving the light towards direction `w` (pointing away from the light): its
+    /// emission on the side its winding faces, nothing behind.
+    #[inline]
+    pub fn radiance_towards(&self, w: Vec3) -> Vec3 {
+        if self.normal.dot(w) > 0.0 { self.emission } else { Vec3::ZERO }
+    }
+
     /// Radiant flux of a Lambertian emitter: `pi * L * A` per channel.
     pub fn power(&self) -> Vec3 {
         std::f32::consts::PI * self.area * self.emission

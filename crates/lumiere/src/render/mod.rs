@@ -121,6 +121,7 @@ pub fn render_progressive(
         Technique::Shadows(shadows) => run_passes(shadows, world, camera, options, film, stats, hooks),
         Technique::Direct(direct) => run_passes(direct, world, camera, options, film, stats, hooks),
         Technique::AmbientOcclusion(ao) => run_passes(ao, world, camera, options, film, stats, hooks),
+        Technique::Path(path) => run_passes(path, world, camera, options, film, stats, hooks),
     }
 }
 

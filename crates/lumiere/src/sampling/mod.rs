@@ -3,4 +3,5 @@
 
 pub mod chi2;
 pub mod distrib;
+pub mod mis;
 pub mod warp;

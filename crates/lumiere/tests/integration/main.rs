@@ -8,6 +8,7 @@ mod estimators;
 mod image_io;
 mod module_graph;
 mod obj_loading;
+mod path;
 mod sampling;
 mod seams;
 mod triangle;

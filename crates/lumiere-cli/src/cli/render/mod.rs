@@ -11,7 +11,7 @@ use std::time::Instant;
 
 use lumiere::Result;
 use lumiere::accel::BuildPreset;
-use lumiere::image_io::{PngEncoding, write_image};
+use lumiere::image_io::{PngEncoding, PngStyle, Tonemap, write_image};
 use lumiere::render::film::Film;
 use lumiere::render::{Hooks, RenderOptions, RenderOutput, RenderStats, StopReason, render_progressive};
 use lumiere::scene::Scene;
@@ -19,7 +19,7 @@ use lumiere::scene::camera::Camera;
 use lumiere::util::write::write_atomically;
 use lumiere::world::World;
 
-use super::args::RenderArgs;
+use super::args::{ModeArg, RenderArgs, TonemapArg};
 use super::output;
 use checkpointing::Fingerprints;
 use report::Timings;
@@ -57,7 +57,7 @@ fn render(args: &RenderArgs, threads: usize) -> Result<u8> {
     signals::rendering_starts();
     let output = render_passes(args, &world, &camera, &options, &fingerprints, film, stats)?;
     report::warn_if_black(&output);
-    write_image(&args.output, output.image.width, output.image.height, &output.image.pixels, png_encoding(args))?;
+    write_image(&args.output, output.image.width, output.image.height, &output.image.pixels, png_style(args))?;
     if let Some(path) = &args.checkpoint {
         fingerprints.save(path, &output.film, &output.stats)?;
     }
@@ -108,7 +108,7 @@ fn render_passes(
             && last_preview.elapsed().as_secs_f64() >= every
         {
             let image = film.image();
-            write_image(&args.output, image.width, image.height, &image.pixels, png_encoding(args))?;
+            write_image(&args.output, image.width, image.height, &image.pixels, png_style(args))?;
             last_preview = Instant::now();
         }
         if let Some(path) = &args.checkpoint
@@ -125,6 +125,16 @@ fn render_passes(
     output
 }
 
-fn png_encoding(args: &RenderArgs) -> PngEncoding {
-    if args.png_linear { PngEncoding::GkitLinear } else { PngEncoding::Srgb }
+fn png_style(args: &RenderArgs) -> PngStyle {
+    let filmic = args.mode == ModeArg::Path;
+    PngStyle {
+        encoding: if args.png_linear { PngEncoding::GkitLinear } else { PngEncoding::Srgb },
+        exposure: args.exposure,
+        tonemap: match args.tonemap {
+            Some(TonemapArg::Aces) => Tonemap::Aces,
+            Some(TonemapArg::Clamp) => Tonemap::Clamp,
+            None if filmic => Tonemap::Aces,
+            None => Tonemap::Clamp,
+        },
+    }
 }

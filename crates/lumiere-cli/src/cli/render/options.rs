@@ -1,7 +1,7 @@
 //! Render arguments to library options: the technique with its own options, and the rest; and the
 //! flags that were given but do nothing for this render.
 
-use lumiere::integrators::{AmbientOcclusion, Direct, Hits, LightSampling, Materials, Shadows, Technique};
+use lumiere::integrators::{AmbientOcclusion, Direct, Hits, LightSampling, Materials, Path, Shadows, Technique};
 use lumiere::render::RenderOptions;
 use lumiere::sampler::SamplerKind;
 
@@ -9,13 +9,18 @@ use crate::cli::args::{LightSamplingArg, ModeArg, RenderArgs, SamplerArg};
 
 /// `--samples` when it is not given.
 const DEFAULT_SAMPLES: u32 = 16;
+/// `--spp` of `--mode path` when it is not given: a picture in a few seconds at 1024x768.
+const DEFAULT_PATH_SPP: u32 = 8;
 /// The look-at camera's field of view when `--fov` is not given (gKit's).
 pub const DEFAULT_FOV: f32 = 45.0;
 
 pub fn from_args(args: &RenderArgs) -> RenderOptions {
     // With a budget and no sample count, render until the budget is met.
     let budget = args.time.is_some() || args.noise.is_some();
-    let spp = args.spp.unwrap_or(if budget { u32::MAX } else { 1 });
+    // Path tracing needs several jittered samples to show anything but noise; the lab's modes
+    // default to its single ray through each pixel centre.
+    let default_spp = if args.mode == ModeArg::Path { DEFAULT_PATH_SPP } else { 1 };
+    let spp = args.spp.unwrap_or(if budget { u32::MAX } else { default_spp });
     RenderOptions {
         technique: technique(args),
         spp,
@@ -46,6 +51,10 @@ fn technique(args: &RenderArgs) -> Technique {
             samples,
             distance: args.ao_distance.unwrap_or(f32::INFINITY),
         }),
+        ModeArg::Path => {
+            let defaults = Path::default();
+            Technique::Path(Path { max_depth: args.max_depth.unwrap_or(defaults.max_depth), ..defaults })
+        }
     }
 }
 
@@ -62,6 +71,7 @@ pub fn ignored_flags(args: &RenderArgs) -> Vec<String> {
     check(args.samples.is_some(), "--samples", matches!(mode, ModeArg::Direct | ModeArg::Ao), "direct and ao only");
     check(args.light_sampling.is_some(), "--light-sampling", mode == ModeArg::Direct, "direct only");
     check(args.ao_distance.is_some(), "--ao-distance", mode == ModeArg::Ao, "ao only");
+    check(args.max_depth.is_some(), "--max-depth", mode == ModeArg::Path, "path only");
     if args.fov.is_some() && args.orbiter.is_some() {
         ignored.push("--fov has no effect with --orbiter (gKit's orbiter camera uses 45 degrees)".to_string());
     } else if args.fov.is_some() && args.scene.is_none() && args.eye.is_none() {

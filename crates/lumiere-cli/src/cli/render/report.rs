@@ -109,7 +109,7 @@ fn samples_per_camera_sample(technique: &Technique) -> Option<u32> {
 /// Why an image may come out black, said before rendering: a technique that needs lights in a
 /// scene that has none.
 pub fn warn_if_unlit(world: &World, options: &RenderOptions) {
-    let needs_lights = matches!(options.technique, Technique::Shadows(_) | Technique::Direct(_));
+    let needs_lights = matches!(options.technique, Technique::Shadows(_) | Technique::Direct(_) | Technique::Path(_));
     if !needs_lights || !world.lights().is_empty() {
         return;
     }
