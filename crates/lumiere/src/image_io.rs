@@ -246,6 +246,43 @@ fn encode_exr(path: &Path, width: u32, height: u32, pixels: &[Vec3]) -> Result<V
     Ok(cursor.into_inner())
 }
 
+/// One set of extra channels of an EXR file: an arbitrary output (AOV) beside the image.
+#[derive(Clone, Copy, Debug)]
+pub struct ExrLayer<'a> {
+    /// The prefix of its channels (`albedo` gives `albedo.R`, `albedo.G`, `albedo.B`).
+    pub name: &'a str,
+    /// The channel names after the prefix, one per component used (`["R", "G", "B"]`, `["Z"]`).
+    pub channels: &'a [&'a str],
+    /// Per pixel, row 0 at the top; channel `i` reads component `i`.
+    pub pixels: &'a [Vec3],
+}
+
+/// Writes an EXR with the image as `R`, `G`, `B` and each layer's channels beside it (32-bit
+/// float, lossless), atomically. Denoisers and compositors read the layers by name.
+pub fn write_exr_with_layers(path: &Path, width: u32, height: u32, pixels: &[Vec3], layers: &[ExrLayer]) -> Result<()> {
+    use exr::prelude::{AnyChannel, AnyChannels, FlatSamples, Image, WritableImage};
+    if format_of(path)? != Format::Exr {
+        return Err(Error::invalid(format!("{}: extra layers (AOVs) need an .exr output", path.display())));
+    }
+    check_dimensions(width, height, pixels.len())?;
+    let main = ExrLayer { name: "", channels: &["R", "G", "B"], pixels };
+    let mut channels = Vec::new();
+    for layer in std::iter::once(&main).chain(layers) {
+        check_dimensions(width, height, layer.pixels.len())?;
+        for (component, channel) in layer.channels.iter().enumerate().take(3) {
+            let name = if layer.name.is_empty() { channel.to_string() } else { format!("{}.{channel}", layer.name) };
+            let samples: Vec<f32> = layer.pixels.iter().map(|p| p[component]).collect();
+            channels.push(AnyChannel::new(name.as_str(), FlatSamples::F32(samples)));
+        }
+    }
+    let mut cursor = Cursor::new(Vec::new());
+    Image::from_channels((width as usize, height as usize), AnyChannels::sort(channels.into()))
+        .write()
+        .to_buffered(&mut cursor)
+        .map_err(|e| Error::invalid(format!("{}: cannot encode EXR: {e}", path.display())))?;
+    write_atomically(path, &cursor.into_inner())
+}
+
 /// Portable Float Map: a negative scale means little-endian, and scanlines run bottom to top.
 fn encode_pfm(width: u32, height: u32, pixels: &[Vec3]) -> Vec<u8> {
     let header = format!("PF\n{width} {height}\n-1.0\n");

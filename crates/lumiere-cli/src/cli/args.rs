@@ -2,6 +2,7 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use glam::Vec3;
+use lumiere::render::aov::Aov;
 
 #[derive(Parser, Debug)]
 #[command(name = "lumiere", version, about = "A CPU Monte Carlo ray tracer", propagate_version = true)]
@@ -226,6 +227,11 @@ pub struct RenderArgs {
     #[arg(long, value_enum)]
     pub tonemap: Option<TonemapArg>,
 
+    /// Extra EXR channels beside the image, comma-separated: albedo (first-hit colour, as denoisers
+    /// want), normal (first-hit shading normal), depth (distance to the first hit). Needs -o *.exr.
+    #[arg(long, value_delimiter = ',', value_parser = parse_aov)]
+    pub aov: Vec<Aov>,
+
     /// Write render statistics (mode, size, rays, timings) as JSON to this file; `-` for stdout.
     #[arg(long)]
     pub stats_json: Option<PathBuf>,
@@ -299,6 +305,10 @@ fn parse_non_negative_f64(s: &str) -> Result<f64, String> {
 fn parse_positive_f32(s: &str) -> Result<f32, String> {
     let value = parse_positive_f64(s)? as f32;
     if value.is_finite() && value > 0.0 { Ok(value) } else { Err(format!("out of range, got {s:?}")) }
+}
+
+fn parse_aov(s: &str) -> Result<Aov, String> {
+    Aov::parse(s.trim()).map_err(|e| e.to_string())
 }
 
 fn parse_exposure(s: &str) -> Result<f32, String> {

@@ -3,6 +3,7 @@
 //! index and the options, never on the thread that ran them, and passes are accumulated in order,
 //! so images are identical for any thread count and for any stopping point.
 
+pub mod aov;
 pub mod checkpoint;
 pub mod film;
 pub mod fingerprint;

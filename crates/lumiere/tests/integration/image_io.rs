@@ -318,3 +318,51 @@ fn check_output_path_rejects_a_read_only_directory() {
     fs::set_permissions(&sub, fs::Permissions::from_mode(0o755)).expect("chmod back");
     assert!(fs::read_dir(&sub).expect("read subdir").next().is_none());
 }
+
+/// AOVs line up with the image: at pixel centres the albedo AOV is what `materials` mode shows,
+/// normals are unit vectors facing the camera, depth is the distance to the hit; and they go to
+/// EXR channels by name, bit for bit.
+#[test]
+fn aovs_match_the_first_hit_and_round_trip_through_exr() {
+    use lumiere::image_io::{ExrLayer, write_exr_with_layers};
+    use lumiere::integrators::{Materials, Technique};
+    use lumiere::render::aov::{Aov, render_aovs};
+    use lumiere::render::{RenderOptions, render};
+    use lumiere::scene::{Scene, builtin, camera::Camera};
+    use lumiere::world::World;
+
+    let world = World::new(Scene::builtin().unwrap(), Default::default());
+    let camera = Camera::from_orbiter(&builtin::cornell_orbiter().unwrap(), 32, 24);
+    let options = RenderOptions::new(Technique::Materials(Materials));
+    let colours = render(&world, &camera, &options, &|_| {}).unwrap().image.pixels;
+    let aovs = render_aovs(&world, &camera, &options, &[Aov::Albedo, Aov::Normal, Aov::Depth]);
+    assert_eq!(aovs[0], colours, "albedo AOV = materials mode at pixel centres");
+    for (i, (n, d)) in aovs[1].iter().zip(&aovs[2]).enumerate() {
+        if colours[i] == Vec3::ZERO {
+            continue;
+        }
+        assert!((n.length() - 1.0).abs() < 1e-4, "pixel {i}: normal {n}");
+        assert!(d.x > 0.0 && d.x.is_finite(), "pixel {i}: depth {d}");
+    }
+
+    let dir = TempDir::new("aov-exr");
+    let path = dir.path("aov.exr");
+    let layers = [
+        ExrLayer { name: "albedo", channels: &["R", "G", "B"], pixels: &aovs[0] },
+        ExrLayer { name: "depth", channels: &["Z"], pixels: &aovs[2] },
+    ];
+    write_exr_with_layers(&path, 32, 24, &colours, &layers).unwrap();
+    let image = exr::prelude::read_all_flat_layers_from_file(&path).unwrap();
+    let layer = &image.layer_data[0];
+    let channel = |name: &str| -> Vec<f32> {
+        let found = layer.channel_data.list.iter().find(|c| c.name.to_string() == name).expect(name);
+        match &found.sample_data {
+            exr::prelude::FlatSamples::F32(values) => values.clone(),
+            _ => panic!("{name} is not f32"),
+        }
+    };
+    assert_eq!(channel("albedo.G"), aovs[0].iter().map(|p| p.y).collect::<Vec<_>>());
+    assert_eq!(channel("depth.Z"), aovs[2].iter().map(|p| p.x).collect::<Vec<_>>());
+    assert_eq!(channel("R"), colours.iter().map(|p| p.x).collect::<Vec<_>>());
+    assert_invalid(write_exr_with_layers(&dir.path("aov.png"), 32, 24, &colours, &layers), "need an .exr");
+}

@@ -11,7 +11,8 @@ use std::time::Instant;
 
 use lumiere::Result;
 use lumiere::accel::BuildPreset;
-use lumiere::image_io::{PngEncoding, PngStyle, Tonemap, write_image};
+use lumiere::image_io::{ExrLayer, PngEncoding, PngStyle, Tonemap, write_exr_with_layers, write_image};
+use lumiere::render::aov::{Aov, render_aovs};
 use lumiere::render::film::Film;
 use lumiere::render::{Hooks, RenderOptions, RenderOutput, RenderStats, StopReason, render_progressive};
 use lumiere::scene::Scene;
@@ -57,7 +58,7 @@ fn render(args: &RenderArgs, threads: usize) -> Result<u8> {
     signals::rendering_starts();
     let output = render_passes(args, &world, &camera, &options, &fingerprints, film, stats)?;
     report::warn_if_black(&output);
-    write_image(&args.output, output.image.width, output.image.height, &output.image.pixels, png_style(args))?;
+    write_output(args, &world, &camera, &options, &output)?;
     if let Some(path) = &args.checkpoint {
         fingerprints.save(path, &output.film, &output.stats)?;
     }
@@ -123,6 +124,36 @@ fn render_passes(
     let output = render_progressive(world, camera, options, film, stats, hooks);
     bar.finish_and_clear();
     output
+}
+
+/// The image, with its AOVs as extra EXR channels when asked for.
+fn write_output(
+    args: &RenderArgs,
+    world: &World,
+    camera: &Camera,
+    options: &RenderOptions,
+    output: &RenderOutput,
+) -> Result<()> {
+    let image = &output.image;
+    if args.aov.is_empty() {
+        return write_image(&args.output, image.width, image.height, &image.pixels, png_style(args));
+    }
+    let buffers = render_aovs(world, camera, options, &args.aov);
+    let layers: Vec<ExrLayer> = args
+        .aov
+        .iter()
+        .zip(&buffers)
+        .map(|(aov, pixels)| ExrLayer {
+            name: aov.name(),
+            channels: match aov {
+                Aov::Albedo => &["R", "G", "B"],
+                Aov::Normal => &["X", "Y", "Z"],
+                Aov::Depth => &["Z"],
+            },
+            pixels,
+        })
+        .collect();
+    write_exr_with_layers(&args.output, image.width, image.height, &image.pixels, &layers)
 }
 
 fn png_style(args: &RenderArgs) -> PngStyle {

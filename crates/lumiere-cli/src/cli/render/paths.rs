@@ -41,6 +41,13 @@ pub fn check(args: &RenderArgs) -> Result<()> {
         inputs.push(Named { flag: "--resume", path });
     }
     check_output_path(&args.output)?;
+    let exr = args.output.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    if !args.aov.is_empty() && !exr {
+        return Err(Error::invalid(format!(
+            "{}: --aov writes extra channels, which only an .exr output can hold",
+            args.output.display()
+        )));
+    }
     for output in &outputs[1..] {
         check_writable(output.path)?;
     }

@@ -1,0 +1,90 @@
+//! Arbitrary output variables: what the camera rays first hit, per pixel, beside the rendered
+//! image — the albedo and normal buffers a denoiser wants, and a depth for debugging.
+//!
+//! They come from a pass of their own over the same jittered pixel positions as the render's first
+//! camera samples (up to [`AOV_SAMPLES`] per pixel), so they line up with the image and cost a few
+//! first-hit rays per pixel whatever the technique.
+
+use glam::{Vec2, Vec3};
+use rayon::prelude::*;
+
+use crate::error::{Error, Result};
+use crate::materials::Bsdf;
+use crate::render::RenderOptions;
+use crate::sampler::{SampleStream, Sampler};
+use crate::scene::camera::Camera;
+use crate::world::World;
+
+/// Camera samples per pixel averaged into the AOVs (fewer if the render has fewer).
+pub const AOV_SAMPLES: u32 = 16;
+
+/// One arbitrary output.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Aov {
+    /// The colour (BSDF albedo) of the first surface hit; black where rays escape.
+    Albedo,
+    /// The shading normal of the first hit in world space, facing the camera; zero where rays escape.
+    Normal,
+    /// The distance along the camera ray to the first hit (in `x`; `y` and `z` copy it); 0 where
+    /// rays escape.
+    Depth,
+}
+
+impl Aov {
+    pub fn name(self) -> &'static str {
+        match self {
+            Aov::Albedo => "albedo",
+            Aov::Normal => "normal",
+            Aov::Depth => "depth",
+        }
+    }
+
+    /// The AOV named `name` (`albedo`, `normal`, `depth`).
+    pub fn parse(name: &str) -> Result<Aov> {
+        [Aov::Albedo, Aov::Normal, Aov::Depth]
+            .into_iter()
+            .find(|aov| aov.name() == name)
+            .ok_or_else(|| Error::invalid(format!("unknown AOV {name:?}: choose among albedo, normal, depth")))
+    }
+}
+
+/// The requested AOVs of the render `options` describes, each as one value per pixel (row 0 at
+/// the top), in the order asked.
+pub fn render_aovs(world: &World, camera: &Camera, options: &RenderOptions, aovs: &[Aov]) -> Vec<Vec<Vec3>> {
+    let sampler = Sampler::new(options.sampler, options.seed);
+    let samples = options.spp.clamp(1, AOV_SAMPLES);
+    let centre = options.samples_pixel_centres();
+    let width = camera.width;
+    let rows: Vec<Vec<[Vec3; 3]>> = (0..camera.height)
+        .into_par_iter()
+        .map(|y| {
+            (0..width)
+                .map(|x| {
+                    let mut sum = [Vec3::ZERO; 3];
+                    for sample in 0..samples {
+                        // The same first dimension as the render's camera sample `sample`.
+                        let jitter = SampleStream::new(&sampler, y * width + x, sample).next_2d();
+                        let offset = if centre { Vec2::splat(0.5) } else { jitter };
+                        let ray = camera.ray(x as f32 + offset.x, y as f32 + offset.y);
+                        let Some(hit) = world.intersect(&ray) else { continue };
+                        let surface = world.surface(&ray, &hit);
+                        sum[0] += world.material(hit.triangle).bsdf().albedo();
+                        sum[1] += surface.ns;
+                        sum[2] += Vec3::splat(hit.t * ray.dir.length());
+                    }
+                    sum.map(|s| s / samples as f32)
+                })
+                .collect()
+        })
+        .collect();
+    aovs.iter()
+        .map(|aov| {
+            let index = match aov {
+                Aov::Albedo => 0,
+                Aov::Normal => 1,
+                Aov::Depth => 2,
+            };
+            rows.iter().flatten().map(|values| values[index]).collect()
+        })
+        .collect()
+}
