@@ -19,7 +19,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ("lights", &["geometry", "math", "sampling", "scene"]),
     ("world", &["accel", "geometry", "lights", "materials", "math", "scene"]),
     ("integrators", &["accel", "error", "geometry", "lights", "materials", "math", "sampler", "sampling", "world"]),
-    ("render", &["accel", "error", "integrators", "math", "sampler", "scene", "util", "world"]),
+    ("render", &["accel", "error", "integrators", "materials", "math", "sampler", "scene", "util", "world"]),
     ("image_io", &["error", "util"]),
 ];
 
