@@ -12,4 +12,5 @@ mod cli;
 mod fuzz_corpus;
 mod fuzz_parsers;
 mod golden;
+mod hostile_inputs;
 mod progressive;
