@@ -35,11 +35,36 @@ impl Error {
 impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Error::Parse { file, line, message } => write!(f, "{}:{line}: {message}", file.display()),
-            Error::Io { path, source } => write!(f, "{}: {source}", path.display()),
+            Error::Parse { file, line, message } => write!(f, "{}:{line}: {message}", shown_path(file)),
+            Error::Io { path, source } => write!(f, "{}: {source}", shown_path(path)),
             Error::Invalid(message) => f.write_str(message),
         }
     }
+}
+
+/// How many characters of a name taken from a file a message quotes.
+pub const QUOTED_CHARS: usize = 80;
+
+/// A name taken from a file (a material, an `mtllib` name, a texture path, a token) as messages
+/// quote it: escaped like a Rust string literal, so that newlines and control characters cannot
+/// split or garble the line, and cut after [`QUOTED_CHARS`] characters, with the name's full length:
+/// `"aaaa…aaaa"… (10000000 bytes)`. Bytes that are not UTF-8 show as U+FFFD.
+pub fn quote(name: impl AsRef<[u8]>) -> String {
+    let bytes = name.as_ref();
+    // A character takes at most 4 bytes and an invalid byte becomes one U+FFFD, so this prefix holds
+    // more than QUOTED_CHARS characters whenever the name is cut: a 10 MB name is never converted whole.
+    let head = String::from_utf8_lossy(&bytes[..bytes.len().min(4 * QUOTED_CHARS + 4)]);
+    match head.char_indices().nth(QUOTED_CHARS) {
+        None => format!("{head:?}"),
+        Some((cut, _)) => format!("{:?}… ({} bytes)", &head[..cut], bytes.len()),
+    }
+}
+
+/// A path as messages show it: as it is when it prints on one line, otherwise escaped and quoted
+/// like [`quote`] (but never cut), so that a file name with a newline cannot split a message.
+pub fn shown_path(path: &Path) -> String {
+    let text = path.to_string_lossy();
+    if text.chars().any(char::is_control) { format!("{text:?}") } else { text.into_owned() }
 }
 
 impl std::error::Error for Error {

@@ -13,4 +13,5 @@ mod edges;
 mod fuzz_corpus;
 mod fuzz_parsers;
 mod golden;
+mod hostile_inputs;
 mod progressive;

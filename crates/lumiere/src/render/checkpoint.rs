@@ -67,7 +67,7 @@ impl Checkpoint {
     }
 
     pub fn load(path: &Path) -> Result<Checkpoint> {
-        let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+        let bytes = crate::util::read::read_regular_file(path).map_err(|e| Error::io(path, e))?;
         Checkpoint::decode(&bytes, path)
     }
 

@@ -27,7 +27,7 @@ pub struct Orbiter {
 
 impl Orbiter {
     pub fn load(path: &Path) -> Result<Orbiter> {
-        let text = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+        let text = crate::util::read::read_regular_file(path).map_err(|e| Error::io(path, e))?;
         Orbiter::parse(&text, path)
     }
 

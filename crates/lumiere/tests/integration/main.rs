@@ -5,6 +5,7 @@ mod common;
 mod bvh;
 mod camera;
 mod estimators;
+mod hostile_inputs;
 mod image_io;
 mod module_graph;
 mod obj_loading;

@@ -2,10 +2,11 @@
 //! triangles, materials and warnings to [`Scene::from_parts`]. Loaders know nothing of rendering.
 
 pub mod obj;
+pub mod warnings;
 
 use std::path::Path;
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, shown_path};
 use crate::scene::Scene;
 
 /// The scene formats lumiere reads, named as in messages.
@@ -17,14 +18,19 @@ pub fn load(path: &Path) -> Result<Scene> {
     let stem = name.strip_suffix(".gz").unwrap_or(&name);
     let extension = Path::new(stem).extension().map(|e| e.to_string_lossy().into_owned()).unwrap_or_default();
     match extension.as_str() {
-        "obj" => obj::load_obj(path)?.into_scene(path.display().to_string()),
+        "obj" => obj::load_obj(path)?.into_scene(shown_path(path)),
+        "mtl" => Err(Error::invalid(format!(
+            "{}: is a material library (.mtl), not a scene; give the .obj file that names it with mtllib",
+            shown_path(path)
+        ))),
         "" => Err(Error::invalid(format!(
             "{}: the file name has no extension, so its format is unknown; lumiere reads {SUPPORTED}",
-            path.display()
+            shown_path(path)
         ))),
         other => Err(Error::invalid(format!(
-            "{}: .{other} scenes are not supported; lumiere reads {SUPPORTED}",
-            path.display()
+            "{}: .{} scenes are not supported; lumiere reads {SUPPORTED}",
+            shown_path(path),
+            crate::error::quote(other).trim_matches('"')
         ))),
     }
 }

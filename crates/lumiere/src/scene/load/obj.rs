@@ -13,16 +13,16 @@ mod materials;
 mod mtl;
 mod text;
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, shown_path};
 use crate::materials::Material;
 use crate::scene::Scene;
 use crate::scene::mesh::{NO_INDEX, TriangleMesh};
 use crate::util::read;
-use chunk::{ChunkCounts, ChunkMesh, ChunkStart, VertexCounts, parse_chunk};
-use materials::{MaterialTable, ReadMtl};
+use chunk::{ChunkCounts, ChunkMesh, ChunkStart, Dropped, VertexCounts, parse_chunk};
+use materials::{MaterialTable, MtlSource, ReadMtl};
 use rayon::prelude::*;
 use std::io;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Chunk size for parallel parsing: large enough that per-chunk overhead is noise, small enough
 /// that a 45 MB file gives dozens of chunks to balance across cores.
@@ -44,23 +44,79 @@ impl ObjScene {
     }
 }
 
+/// Bytes per triangle that `World::new` adds to the mesh: the BVH (about 80 bytes per triangle)
+/// and the temporaries of its build, at their peak. Measured on the 1.1M-triangle bunny with
+/// `/usr/bin/time -v lumiere render stanford-bunny-1m.obj.gz --size 8x6 --mode hits` (2 threads):
+/// 194 MB maximum resident, less 5 MB for the process and 24.5 MB for the mesh, is 148 bytes per
+/// triangle; rounded up. (Loading alone peaks at 92 MB: the 45 MB of text and twice the mesh.)
+const BVH_BYTES_PER_TRIANGLE: u64 = 160;
+
+/// Scenes estimated below this are not checked against the free memory (reading it costs three
+/// /proc files, and fuzzing parses millions of tiny files).
+const UNCHECKED_BYTES: u64 = 16 << 20;
+
+/// The memory a load may use: the system's (see [`read::available_memory`]) or, for tests, given.
+#[derive(Clone, Copy, Debug)]
+enum Memory {
+    System,
+    Given(u64),
+}
+
+impl Memory {
+    /// The bytes available when a load needs `needed`; `None` when it need not be checked.
+    fn available(self, needed: u64) -> Option<u64> {
+        match self {
+            Memory::System if needed < UNCHECKED_BYTES => None,
+            Memory::System => read::available_memory(),
+            Memory::Given(bytes) => Some(bytes),
+        }
+    }
+}
+
 /// Loads `path` (`.obj` or `.obj.gz`); `mtllib` files resolve relative to the OBJ's folder.
+///
+/// Every file is read through [`read::read_regular_file`] (FIFOs, devices and directories are
+/// refused); a scene whose mesh and BVH would not fit in the memory left is refused before its
+/// triangles are allocated; an MTL file named many times is read once.
 pub fn load_obj(path: &Path) -> Result<ObjScene> {
-    let bytes = read::read_input(path).map_err(|error| Error::io(path, error))?;
+    load_obj_within(path, Memory::System)
+}
+
+/// [`load_obj`] as if `available` bytes of memory were left, so that tests can check the
+/// refusal of scenes too big for memory without allocating gigabytes.
+#[doc(hidden)]
+pub fn load_obj_with_memory(path: &Path, available: u64) -> Result<ObjScene> {
+    load_obj_within(path, Memory::Given(available))
+}
+
+fn load_obj_within(path: &Path, memory: Memory) -> Result<ObjScene> {
+    let given = match memory {
+        Memory::System => read::available_memory(),
+        Memory::Given(bytes) => Some(bytes),
+    };
+    let bytes = read::read_input_with_memory(path, given).map_err(|error| Error::io(path, error))?;
     let folder = path.parent().unwrap_or(Path::new(""));
+    // `a.mtl`, `./a.mtl` and `.//a.mtl` are one file, and so is `x/../a.mtl` when it exists.
+    let lexical = |name: &str| folder.join(name).components().collect::<PathBuf>();
+    let locate = |name: &str| Some(std::fs::canonicalize(folder.join(name)).unwrap_or_else(|_| lexical(name)));
     let read_mtl = |name: &str| {
-        let mtl = folder.join(name);
+        let mtl = lexical(name);
         match read::read_input(&mtl) {
             Ok(bytes) => Ok((bytes, mtl)),
-            // The OBJ only knows the name; the warning should say where we looked.
-            Err(error) => Err(io::Error::new(error.kind(), format!("{}: {error}", mtl.display()))),
+            // The OBJ only knows the name; the warning should say where a relative one was looked for.
+            Err(error) if Path::new(name).is_relative() => {
+                let looked_in = if folder.as_os_str().is_empty() { Path::new(".") } else { folder };
+                Err(io::Error::new(error.kind(), format!("{error}; looked in {}", shown_path(looked_in))))
+            }
+            Err(error) => Err(error),
         }
     };
-    parse_obj(&bytes, path, &read_mtl)
+    parse_obj_within(&bytes, path, MtlSource { read: &read_mtl, locate: &locate }, CHUNK_BYTES, memory)
 }
 
 /// Parses OBJ text. `name` is used in error messages; `read_mtl(file_name)` returns the MTL file's
 /// bytes and the path it came from (for messages and for resolving `map_Kd`), or an I/O error.
+/// Each MTL file (by the path `read_mtl` returns) is read and warned about once.
 #[expect(clippy::type_complexity, reason = "the closure type is spelled out so callers see it in the docs")]
 pub fn parse_obj(
     bytes: &[u8],
@@ -74,20 +130,87 @@ pub fn parse_obj(
 /// inputs and compare with a single chunk (`usize::MAX`).
 #[doc(hidden)]
 pub fn parse_obj_with_chunk_size(bytes: &[u8], name: &Path, read_mtl: ReadMtl, chunk_bytes: usize) -> Result<ObjScene> {
+    parse_obj_within(bytes, name, MtlSource { read: read_mtl, locate: &|_| None }, chunk_bytes, Memory::System)
+}
+
+/// [`parse_obj`] as if `available` bytes of memory were left (see [`load_obj_with_memory`]).
+#[doc(hidden)]
+pub fn parse_obj_with_memory(bytes: &[u8], name: &Path, read_mtl: ReadMtl, available: u64) -> Result<ObjScene> {
+    let source = MtlSource { read: read_mtl, locate: &|_| None };
+    parse_obj_within(bytes, name, source, CHUNK_BYTES, Memory::Given(available))
+}
+
+fn parse_obj_within(
+    bytes: &[u8],
+    name: &Path,
+    source: MtlSource,
+    chunk_bytes: usize,
+    memory: Memory,
+) -> Result<ObjScene> {
     // Editors on Windows may start the file with a UTF-8 byte-order mark.
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
     let chunks = split_lines(bytes, chunk_bytes.max(1));
     let counts: Vec<ChunkCounts> = chunks.par_iter().map(|chunk| ChunkCounts::of(chunk)).collect();
     let (starts, totals) = chunk_starts(&counts);
+    let triangles = counts.iter().map(|count| count.triangles as u64).sum();
+    check_memory(totals, triangles, name, memory)?;
     let parsed: Vec<Result<ChunkMesh>> = (chunks.par_iter().zip(&counts).zip(starts))
         .map(|((chunk, counts), start)| parse_chunk(chunk, counts, start, totals, name))
         .collect();
     // Sequentially, so that the error reported is the first one in the file.
     let parsed = parsed.into_iter().collect::<Result<Vec<_>>>()?;
     let libraries = parsed.iter().flat_map(|chunk| &chunk.libraries);
-    let mut table = MaterialTable::load(libraries, name, read_mtl);
+    let mut table = MaterialTable::load(libraries, name, source);
     let material_ids = material_ids(&parsed, &mut table, name);
-    Ok(ObjScene { mesh: merge(&parsed, material_ids), materials: table.materials, warnings: table.warnings })
+    let dropped = |field: fn(&ChunkMesh) -> Dropped| parsed.iter().fold(Dropped::default(), |a, c| a.merge(field(c)));
+    let (texcoords, normals) = (dropped(|c| c.dropped_texcoords), dropped(|c| c.dropped_normals));
+    let kind = "texture-coordinate indices out of range";
+    warn_dropped(&mut table, name, texcoords, "texture-coordinate", "texture coordinates", kind);
+    warn_dropped(&mut table, name, normals, "normal", "normals", "normal indices out of range");
+    let warnings = std::mem::take(&mut table.warnings).finish();
+    Ok(ObjScene { mesh: merge(&parsed, material_ids), materials: table.materials, warnings })
+}
+
+/// The memory the mesh of `vertices` and `triangles` needs while it is parsed and then rendered:
+/// parsing holds the chunks' vectors and their concatenation at once; rendering holds the mesh
+/// and the BVH. The text itself is already in memory.
+fn estimated_bytes(vertices: VertexCounts, triangles: u64) -> u64 {
+    let count = |n: usize| n as u64;
+    let vertex_bytes = 12 * count(vertices.positions) + 8 * count(vertices.texcoords) + 12 * count(vertices.normals);
+    // Position indices and material id, and attribute indices when the file has such attributes.
+    let per_triangle = 12 + 4 + 12 * u64::from(vertices.texcoords > 0) + 12 * u64::from(vertices.normals > 0);
+    let mesh = vertex_bytes.saturating_add(per_triangle.saturating_mul(triangles));
+    mesh.saturating_mul(2).max(mesh.saturating_add(BVH_BYTES_PER_TRIANGLE.saturating_mul(triangles)))
+}
+
+/// Refuses, before anything is allocated, a scene whose mesh and BVH would not fit in memory.
+fn check_memory(vertices: VertexCounts, triangles: u64, name: &Path, memory: Memory) -> Result<()> {
+    let needed = estimated_bytes(vertices, triangles);
+    let Some(available) = memory.available(needed) else { return Ok(()) };
+    if needed <= available {
+        return Ok(());
+    }
+    let gib = |bytes: u64| bytes as f64 / (1u64 << 30) as f64;
+    let message = format!(
+        "needs about {:.1} GiB of memory for its {triangles} triangles and {} vertices (mesh and BVH), but only \
+         {:.1} GiB is available; refusing it",
+        gib(needed),
+        vertices.positions,
+        gib(available)
+    );
+    Err(Error::io(name, io::Error::new(io::ErrorKind::OutOfMemory, message)))
+}
+
+/// One warning for all the faces that lost `what` indices because they pointed at nothing.
+fn warn_dropped(table: &mut MaterialTable, obj: &Path, dropped: Dropped, what: &str, plural: &str, kind: &'static str) {
+    let (Some(line), faces) = (dropped.first_line, dropped.faces) else { return };
+    table.warnings.push(obj, kind, || {
+        let (have, those) = if faces == 1 { ("face has", "its") } else { ("faces have", "those") };
+        format!(
+            "{}:{line}: {faces} {have} {what} indices out of range (the first on this line); {those} {plural} are ignored",
+            shown_path(obj)
+        )
+    });
 }
 
 /// Cuts `bytes` into pieces of about `target` bytes, each ending just after a `\n` (but the last).

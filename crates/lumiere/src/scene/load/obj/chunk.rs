@@ -39,8 +39,9 @@ pub(super) struct ChunkCounts {
     /// Number of `\n` in the chunk; chunks end right after a `\n`, except the last one.
     pub(super) lines: usize,
     pub(super) vertices: VertexCounts,
-    /// Number of `f` lines, to size the triangle vectors (a polygon adds more).
-    pub(super) faces: usize,
+    /// Triangles the `f` lines make once fanned (a face of n corners makes n - 2), to size the
+    /// triangle vectors and estimate the memory before allocating any.
+    pub(super) triangles: usize,
 }
 
 impl ChunkCounts {
@@ -52,7 +53,7 @@ impl ChunkCounts {
                 Some(b"v") => counts.vertices.positions += 1,
                 Some(b"vt") => counts.vertices.texcoords += 1,
                 Some(b"vn") => counts.vertices.normals += 1,
-                Some(b"f") => counts.faces += 1,
+                Some(b"f") => counts.triangles += corners(line).saturating_sub(2),
                 _ => {}
             }
         }
@@ -60,6 +61,22 @@ impl ChunkCounts {
         counts.lines -= 1;
         counts
     }
+}
+
+/// The corners of an `f` line: its tokens after the keyword, up to a comment. A loop the compiler
+/// vectorises rather than [`Tokens`], since it runs on every face line of the first pass; control
+/// bytes count as separators, which only matters for malformed lines the second pass refuses.
+fn corners(line: &[u8]) -> usize {
+    let line = line.split(|&b| b == b'#').next().unwrap_or_default();
+    let mut count: usize = 0;
+    let mut after_space = true;
+    for &byte in line {
+        let space = byte <= b' ';
+        count += usize::from(after_space && !space);
+        after_space = space;
+    }
+    // The first token is the `f` itself.
+    count.saturating_sub(1)
 }
 
 /// Where a chunk starts: lines and vertices before its first line.
@@ -97,6 +114,30 @@ pub(super) struct ChunkMesh<'a> {
     pub(super) normal_indices: Vec<[u32; 3]>,
     pub(super) material_switches: Vec<MaterialSwitch<'a>>,
     pub(super) libraries: Vec<MaterialLibrary<'a>>,
+    /// Faces with a texture-coordinate index out of range (dropped for those corners).
+    pub(super) dropped_texcoords: Dropped,
+    /// Faces with a normal index out of range (dropped for those corners).
+    pub(super) dropped_normals: Dropped,
+}
+
+/// Faces that lost an attribute index because it pointed at nothing.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Dropped {
+    pub(super) faces: usize,
+    /// The line of the first such face.
+    pub(super) first_line: Option<usize>,
+}
+
+impl Dropped {
+    fn add(&mut self, line: usize) {
+        self.faces += 1;
+        self.first_line.get_or_insert(line);
+    }
+
+    /// Sums the counts of consecutive chunks: the first line is the earliest.
+    pub(super) fn merge(self, later: Dropped) -> Dropped {
+        Dropped { faces: self.faces + later.faces, first_line: self.first_line.or(later.first_line) }
+    }
 }
 
 /// Parses the lines of `chunk`. `totals` are the file's vertex counts, which positive indices are
@@ -125,6 +166,13 @@ struct Corner {
     normal: u32,
 }
 
+/// Which attribute indices of a corner were dropped.
+#[derive(Clone, Copy, Default)]
+struct CornerDropped {
+    texcoord: bool,
+    normal: bool,
+}
+
 /// Which vertex array an index points into.
 #[derive(Clone, Copy)]
 enum Attribute {
@@ -144,7 +192,7 @@ impl<'a> ChunkParser<'a> {
         self.mesh.positions.reserve_exact(counts.vertices.positions);
         self.mesh.texcoords.reserve_exact(counts.vertices.texcoords);
         self.mesh.normals.reserve_exact(counts.vertices.normals);
-        self.mesh.indices.reserve(counts.faces);
+        self.mesh.indices.reserve_exact(counts.triangles);
     }
 
     /// Parses one line; the error message gets the file and line from the caller.
@@ -154,7 +202,7 @@ impl<'a> ChunkParser<'a> {
             Some(b"v") => self.mesh.positions.push(Vec3::from(numbers(tokens, 3)?)),
             Some(b"vt") => self.mesh.texcoords.push(Vec2::from(numbers(tokens, 1)?)),
             Some(b"vn") => self.mesh.normals.push(Vec3::from(numbers(tokens, 3)?)),
-            Some(b"f") => self.face(tokens)?,
+            Some(b"f") => self.face(tokens, line_number)?,
             Some(b"usemtl") => self.use_material(tokens, line_number)?,
             Some(b"mtllib") => {
                 let names = tokens.remainder();
@@ -177,12 +225,15 @@ impl<'a> ChunkParser<'a> {
 
     /// Splits a polygon into the fan `(a,b,c), (a,c,d), ...` in file order, as gKit does, so that
     /// triangle ids match its renders.
-    fn face(&mut self, tokens: Tokens) -> Result<(), String> {
+    fn face(&mut self, tokens: Tokens, line: usize) -> Result<(), String> {
         let mut first = None;
         let mut previous = None;
         let mut count = 0;
+        let (mut texcoord_dropped, mut normal_dropped) = (false, false);
         for token in tokens {
-            let corner = self.corner(token)?;
+            let (corner, dropped) = self.corner(token)?;
+            texcoord_dropped |= dropped.texcoord;
+            normal_dropped |= dropped.normal;
             count += 1;
             let Some(a) = first else {
                 first = Some(corner);
@@ -196,24 +247,34 @@ impl<'a> ChunkParser<'a> {
         if count < 3 {
             return Err(format!("face with {count} corner(s); a face needs at least 3"));
         }
+        if texcoord_dropped {
+            self.mesh.dropped_texcoords.add(line);
+        }
+        if normal_dropped {
+            self.mesh.dropped_normals.add(line);
+        }
         Ok(())
     }
 
-    fn corner(&self, token: &[u8]) -> Result<Corner, String> {
+    /// The corner's indices, and which attribute indices were dropped for pointing at nothing.
+    /// A position out of range is an error; a texture coordinate or a normal out of range (or 0)
+    /// is dropped (the corner has none), as mainstream loaders accept such files.
+    fn corner(&self, token: &[u8]) -> Result<(Corner, CornerDropped), String> {
         let malformed = || format!("malformed face corner {} (expected v, v/vt, v//vn or v/vt/vn)", quoted(token));
         let CornerFields { position, texcoord, normal } = corner_fields(token).ok_or_else(malformed)?;
-        let index = |field: Option<&[u8]>, attribute| match field {
-            None => Ok(NO_INDEX),
-            Some(field) => {
-                let raw = saturating_i64(field).ok_or_else(malformed)?;
-                self.resolve(raw, field, attribute)
-            }
+        let raw = |field: &[u8]| saturating_i64(field).ok_or_else(malformed);
+        let position = self.resolve(raw(position)?, position, Attribute::Position)?;
+        let mut dropped = CornerDropped::default();
+        let attribute = |field: Option<&[u8]>, attribute, dropped: &mut bool| -> Result<u32, String> {
+            let Some(field) = field else { return Ok(NO_INDEX) };
+            Ok(self.resolve(raw(field)?, field, attribute).unwrap_or_else(|_| {
+                *dropped = true;
+                NO_INDEX
+            }))
         };
-        Ok(Corner {
-            position: index(Some(position), Attribute::Position)?,
-            texcoord: index(texcoord, Attribute::Texcoord)?,
-            normal: index(normal, Attribute::Normal)?,
-        })
+        let texcoord = attribute(texcoord, Attribute::Texcoord, &mut dropped.texcoord)?;
+        let normal = attribute(normal, Attribute::Normal, &mut dropped.normal)?;
+        Ok((Corner { position, texcoord, normal }, dropped))
     }
 
     /// Turns a 1-based or negative (relative to the vertices defined so far) index into a 0-based
@@ -228,7 +289,8 @@ impl<'a> ChunkParser<'a> {
             }
             Attribute::Normal => ("normal", self.start.normals + self.mesh.normals.len(), self.totals.normals),
         };
-        let field = || String::from_utf8_lossy(field);
+        // Digits only (the field parsed as an integer), but maybe 10 MB of them: cut like names.
+        let field = || if field.len() <= 40 { String::from_utf8_lossy(field).into_owned() } else { quoted(field) };
         if raw == 0 {
             return Err(format!("{what} index 0: OBJ indices start at 1"));
         }

@@ -3,7 +3,9 @@
 
 use super::chunk::MaterialLibrary;
 use super::mtl::parse_mtl;
+use crate::error::{quote, shown_path};
 use crate::materials::Material;
+use crate::scene::load::warnings::Warnings;
 use std::collections::{HashMap, HashSet};
 use std::io;
 use std::path::{Path, PathBuf};
@@ -11,72 +13,118 @@ use std::path::{Path, PathBuf};
 /// Reads an MTL file by the name an OBJ gives it; see [`super::parse_obj`].
 pub(super) type ReadMtl<'r> = &'r dyn Fn(&str) -> io::Result<(Vec<u8>, PathBuf)>;
 
+/// Where the MTL files of an OBJ come from.
+#[derive(Clone, Copy)]
+pub(super) struct MtlSource<'r> {
+    pub(super) read: ReadMtl<'r>,
+    /// The file a name resolves to, known before reading it (on the file system), so that a
+    /// library named under many spellings (`a.mtl`, `./a.mtl`, `x/../a.mtl`) is read once. `None`
+    /// where only reading tells (in-memory sources); the path the read returns is used then.
+    pub(super) locate: &'r dyn Fn(&str) -> Option<PathBuf>,
+}
+
 /// Name of the material of faces that come before any `usemtl`.
 const DEFAULT_NAME: &str = "default";
 
 #[derive(Debug, Default)]
 pub(super) struct MaterialTable {
     pub(super) materials: Vec<Material>,
-    pub(super) warnings: Vec<String>,
+    pub(super) warnings: Warnings,
     ids: HashMap<String, u32>,
     default_id: Option<u32>,
 }
 
+/// What became of one name `mtllib` gave.
+enum Outcome {
+    /// Read now, or already read (or already refused) under this name or this path.
+    Done,
+    Failed(io::Error),
+}
+
+/// The libraries tried so far: each name is tried once, and each file is read (or warned about)
+/// once, however many `mtllib` lines or spellings name it.
+struct Tried<'r> {
+    source: MtlSource<'r>,
+    names: HashSet<String>,
+    paths: HashSet<PathBuf>,
+}
+
 impl MaterialTable {
-    /// Loads every library named by `mtllib`, each once, whatever the order of the statements.
+    /// Loads every library named by `mtllib`, each file once, whatever the order of the statements.
     pub(super) fn load<'a>(
         libraries: impl Iterator<Item = &'a MaterialLibrary<'a>>,
         obj: &Path,
-        read_mtl: ReadMtl,
+        source: MtlSource,
     ) -> Self {
         let mut table = MaterialTable::default();
-        let mut seen = HashSet::new();
+        let mut tried = Tried { source, names: HashSet::new(), paths: HashSet::new() };
+        let mut lines = HashSet::new();
         for library in libraries {
-            if seen.insert(library.names.as_ref()) {
-                table.load_library(library, obj, read_mtl);
+            if lines.insert(library.names.as_ref()) {
+                table.load_library(library, obj, &mut tried);
             }
         }
         table
     }
 
-    /// `mtllib` may list several files, or one file whose name has spaces: the whole line is tried
-    /// as one name first, then each word.
-    fn load_library(&mut self, library: &MaterialLibrary, obj: &Path, read_mtl: ReadMtl) {
-        let whole = library.names.as_ref();
-        let error = match read_mtl(whole) {
-            Ok((bytes, path)) => return self.add_file(&bytes, &path),
-            Err(error) => error,
-        };
-        let words: Vec<&str> = whole.split_ascii_whitespace().collect();
+    /// `mtllib` may list several files, or one file whose name has spaces, escaped (`my\ file.mtl`)
+    /// or not: the whole line is tried as one name first, then each word.
+    fn load_library(&mut self, library: &MaterialLibrary, obj: &Path, tried: &mut Tried) {
+        let whole = unescape(&library.names);
+        let Outcome::Failed(error) = self.try_library(&whole, tried) else { return };
+        let words = split_names(&library.names);
         if words.len() < 2 {
-            return self.warn_unreadable(obj, library.line, whole, &error);
+            return self.warn_unreadable(obj, library.line, &whole, &error);
         }
-        for word in words {
-            match read_mtl(word) {
-                Ok((bytes, path)) => self.add_file(&bytes, &path),
-                Err(error) => self.warn_unreadable(obj, library.line, word, &error),
+        for word in &words {
+            if let Outcome::Failed(error) = self.try_library(word, tried) {
+                self.warn_unreadable(obj, library.line, word, &error);
             }
         }
     }
 
+    fn try_library(&mut self, name: &str, tried: &mut Tried) -> Outcome {
+        if !tried.names.insert(name.to_string()) {
+            return Outcome::Done;
+        }
+        let located = (tried.source.locate)(name);
+        if let Some(path) = &located
+            && !tried.paths.insert(path.clone())
+        {
+            return Outcome::Done;
+        }
+        match (tried.source.read)(name) {
+            Ok((bytes, path)) => {
+                if located.is_some() || tried.paths.insert(path.clone()) {
+                    self.add_file(&bytes, &path);
+                }
+                Outcome::Done
+            }
+            Err(error) => Outcome::Failed(error),
+        }
+    }
+
     fn warn_unreadable(&mut self, obj: &Path, line: usize, name: &str, error: &io::Error) {
-        self.warnings.push(format!(
-            "{}:{line}: cannot read material library {name:?} ({error}); its materials will be grey",
-            obj.display()
-        ));
+        self.warnings.push(obj, "unreadable material libraries", || {
+            format!(
+                "{}:{line}: cannot read material library {} ({error}); its materials will be grey",
+                shown_path(obj),
+                quote(name)
+            )
+        });
     }
 
     /// Adds the materials of one MTL file. A name defined twice keeps its first definition.
     fn add_file(&mut self, bytes: &[u8], path: &Path) {
-        let file = parse_mtl(bytes, path);
-        self.warnings.extend(file.warnings);
-        for material in file.materials {
+        for material in parse_mtl(bytes, path, &mut self.warnings) {
             if self.ids.contains_key(&material.name) {
-                self.warnings.push(format!(
-                    "{}: material {:?} is defined again; keeping the first definition",
-                    path.display(),
-                    material.name
-                ));
+                self.warnings.push(path, "materials defined again", || {
+                    format!(
+                        "{}: material {} is defined again; keeping the first definition",
+                        shown_path(path),
+                        quote(&material.name)
+                    )
+                });
                 continue;
             }
             let name = material.name.clone();
@@ -99,8 +147,9 @@ impl MaterialTable {
         if let Some(&id) = self.ids.get(name) {
             return id;
         }
-        self.warnings
-            .push(format!("{}:{line}: material {name:?} is not defined in any MTL file; using grey", obj.display()));
+        self.warnings.push(obj, "undefined materials", || {
+            format!("{}:{line}: material {} is not defined in any MTL file; using grey", shown_path(obj), quote(name))
+        });
         let id = self.push(Material::default_grey(name));
         self.ids.insert(name.to_string(), id);
         id
@@ -110,4 +159,41 @@ impl MaterialTable {
         self.materials.push(material);
         u32::try_from(self.materials.len() - 1).unwrap_or(u32::MAX)
     }
+}
+
+/// The line with its escaped whitespace (`\ `) unescaped, as one file name.
+fn unescape(line: &str) -> String {
+    let mut name = String::with_capacity(line.len());
+    let mut chars = line.chars().peekable();
+    while let Some(c) = chars.next() {
+        match c {
+            '\\' if chars.peek().is_some_and(|next| next.is_ascii_whitespace()) => name.extend(chars.next()),
+            c => name.push(c),
+        }
+    }
+    name
+}
+
+/// The file names of an `mtllib` line: split at whitespace, except where a backslash escapes it
+/// (`my\ file.mtl` is `my file.mtl`, as Blender and 3ds Max write names with spaces). Other
+/// backslashes are kept as they are.
+fn split_names(line: &str) -> Vec<String> {
+    let mut names = Vec::new();
+    let mut name = String::new();
+    let mut chars = line.chars().peekable();
+    while let Some(c) = chars.next() {
+        match c {
+            '\\' if chars.peek().is_some_and(|next| next.is_ascii_whitespace()) => name.extend(chars.next()),
+            c if c.is_ascii_whitespace() => {
+                if !name.is_empty() {
+                    names.push(std::mem::take(&mut name));
+                }
+            }
+            c => name.push(c),
+        }
+    }
+    if !name.is_empty() {
+        names.push(name);
+    }
+    names
 }

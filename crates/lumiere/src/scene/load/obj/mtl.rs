@@ -2,29 +2,25 @@
 //! because a render with one wrong material is more useful than no render.
 
 use super::text::{Tokens, finite_f32, lines, quoted};
+use crate::error::shown_path;
 use crate::materials::Material;
+use crate::scene::load::warnings::Warnings;
 use glam::Vec3;
 use std::path::{Path, PathBuf};
 
-/// The materials of one MTL file, in file order, and one warning per line that was ignored.
-#[derive(Debug, Default)]
-pub(super) struct MtlFile {
-    pub(super) materials: Vec<Material>,
-    pub(super) warnings: Vec<String>,
-}
-
-/// Parses the MTL file read from `path`; `map_Kd` files resolve relative to its folder.
-pub(super) fn parse_mtl(bytes: &[u8], path: &Path) -> MtlFile {
+/// Parses the MTL file read from `path` into its materials, in file order, with one warning per
+/// line that was ignored (capped, see [`Warnings`]); `map_Kd` files resolve relative to its folder.
+pub(super) fn parse_mtl(bytes: &[u8], path: &Path, warnings: &mut Warnings) -> Vec<Material> {
     let folder = path.parent().unwrap_or(Path::new(""));
-    let mut file = MtlFile::default();
+    let mut materials: Vec<Material> = Vec::new();
     for (i, line) in lines(bytes).enumerate() {
         let problem = match parse_statement(line, folder) {
             Ok(None) => continue,
             Ok(Some(Statement::NewMtl(name))) => {
-                file.materials.push(Material::default_grey(&name));
+                materials.push(Material::default_grey(&name));
                 continue;
             }
-            Ok(Some(statement)) => match file.materials.last_mut() {
+            Ok(Some(statement)) => match materials.last_mut() {
                 Some(material) => {
                     statement.apply(material);
                     continue;
@@ -33,9 +29,9 @@ pub(super) fn parse_mtl(bytes: &[u8], path: &Path) -> MtlFile {
             },
             Err(message) => message,
         };
-        file.warnings.push(format!("{}:{}: {problem}; line ignored", path.display(), i + 1));
+        warnings.push(path, "ignored MTL lines", || format!("{}:{}: {problem}; line ignored", shown_path(path), i + 1));
     }
-    file
+    materials
 }
 
 /// The MTL statements we keep; everything else (`Ka`, `map_Bump`, ...) is skipped silently.

@@ -4,6 +4,7 @@
 //! files and would reject old files whose comments are Latin-1. Only the tokens that must be text
 //! (numbers, names) are converted, each on its own, so a stray byte never aborts a whole file.
 
+use crate::error::quote;
 use std::borrow::Cow;
 
 /// The lines of `bytes`, split at `\n`. A CRLF line keeps its `\r`, which the tokenizer treats as
@@ -52,15 +53,10 @@ impl<'a> Iterator for Tokens<'a> {
     }
 }
 
-/// A token quoted for an error message, readable even when it is not UTF-8.
-/// The token as it should appear in an error message: quoted, and cut to its first 40 bytes so
-/// that a hostile 10 MB token does not make a 10 MB message.
+/// The token as it should appear in a message: quoted, escaped and cut (see [`quote`]), so that a
+/// hostile 10 MB token does not make a 10 MB message.
 pub(super) fn quoted(token: &[u8]) -> String {
-    const SHOWN: usize = 40;
-    if token.len() <= SHOWN {
-        return format!("{:?}", String::from_utf8_lossy(token));
-    }
-    format!("{:?}... ({} bytes)", String::from_utf8_lossy(&token[..SHOWN]), token.len())
+    quote(token)
 }
 
 /// Parses a finite `f32`. NaN and infinities are refused: they would poison the BVH bounds.
