@@ -4,6 +4,7 @@
 //! a crash, a full disk or a killed process never leaves a half-written image where a previous good
 //! one used to be: readers see either the old file or the complete new one.
 
+use crate::error::shown_path;
 use std::io::Cursor;
 use std::path::Path;
 use std::sync::OnceLock;
@@ -185,11 +186,11 @@ fn format_of(path: &Path) -> Result<Format> {
         Some("pfm") => Ok(Format::Pfm),
         Some(other) => Err(Error::invalid(format!(
             "{}: .{other} is not an image format lumiere writes (supported: {SUPPORTED})",
-            path.display()
+            shown_path(path)
         ))),
         None => Err(Error::invalid(format!(
             "{}: the file name has no extension, so the image format is unknown (supported: {SUPPORTED})",
-            path.display()
+            shown_path(path)
         ))),
     }
 }
@@ -223,7 +224,7 @@ fn encode_png(path: &Path, width: u32, height: u32, pixels: &[Vec3], style: PngS
     if style.encoding == PngEncoding::Srgb {
         encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
     }
-    let failed = |e: png::EncodingError| Error::invalid(format!("{}: cannot encode PNG: {e}", path.display()));
+    let failed = |e: png::EncodingError| Error::invalid(format!("{}: cannot encode PNG: {e}", shown_path(path)));
     let mut writer = encoder.write_header().map_err(failed)?;
     writer.write_image_data(&raw).map_err(failed)?;
     writer.finish().map_err(failed)?;
@@ -242,7 +243,7 @@ fn encode_exr(path: &Path, width: u32, height: u32, pixels: &[Vec3]) -> Result<V
     Image::from_channels((w, height as usize), channels)
         .write()
         .to_buffered(&mut cursor)
-        .map_err(|e| Error::invalid(format!("{}: cannot encode EXR: {e}", path.display())))?;
+        .map_err(|e| Error::invalid(format!("{}: cannot encode EXR: {e}", shown_path(path))))?;
     Ok(cursor.into_inner())
 }
 
@@ -262,7 +263,7 @@ pub struct ExrLayer<'a> {
 pub fn write_exr_with_layers(path: &Path, width: u32, height: u32, pixels: &[Vec3], layers: &[ExrLayer]) -> Result<()> {
     use exr::prelude::{AnyChannel, AnyChannels, FlatSamples, Image, WritableImage};
     if format_of(path)? != Format::Exr {
-        return Err(Error::invalid(format!("{}: extra layers (AOVs) need an .exr output", path.display())));
+        return Err(Error::invalid(format!("{}: extra layers (AOVs) need an .exr output", shown_path(path))));
     }
     check_dimensions(width, height, pixels.len())?;
     let main = ExrLayer { name: "", channels: &["R", "G", "B"], pixels };
@@ -279,7 +280,7 @@ pub fn write_exr_with_layers(path: &Path, width: u32, height: u32, pixels: &[Vec
     Image::from_channels((width as usize, height as usize), AnyChannels::sort(channels.into()))
         .write()
         .to_buffered(&mut cursor)
-        .map_err(|e| Error::invalid(format!("{}: cannot encode EXR: {e}", path.display())))?;
+        .map_err(|e| Error::invalid(format!("{}: cannot encode EXR: {e}", shown_path(path))))?;
     write_atomically(path, &cursor.into_inner())
 }
 

@@ -8,6 +8,7 @@
 //! [`super::fingerprint::options_description`]), then a u64 hash of all the preceding bytes. Files
 //! are written atomically; a truncated or altered file is refused.
 
+use crate::error::shown_path;
 use std::path::Path;
 use std::time::Duration;
 
@@ -73,7 +74,7 @@ impl Checkpoint {
 
     /// Parses checkpoint bytes; `path` names the file in errors. Never panics on bad input.
     pub fn decode(bytes: &[u8], path: &Path) -> Result<Checkpoint> {
-        let bad = |what: &str| Error::invalid(format!("{}: not a valid lumiere checkpoint ({what})", path.display()));
+        let bad = |what: &str| Error::invalid(format!("{}: not a valid lumiere checkpoint ({what})", shown_path(path)));
         if bytes.len() < HEADER_BYTES + 8 || &bytes[..8] != MAGIC {
             return Err(bad("no checkpoint header"));
         }

@@ -24,6 +24,9 @@ pub struct Scene {
     pub materials: Vec<Material>,
     /// Non-fatal problems met while loading (missing MTL, unknown material), for the user to see.
     pub warnings: Vec<String>,
+    /// The files read besides the scene file itself (material libraries), so that no output ever
+    /// overwrites one; textures are named by their materials.
+    pub sources: Vec<std::path::PathBuf>,
 }
 
 impl Scene {
@@ -58,7 +61,7 @@ impl Scene {
         if let Some(bad) = mesh.indices.iter().flatten().find(|&&i| i as usize >= mesh.positions.len()) {
             return Err(Error::invalid(format!("{name}: vertex index {bad} out of range")));
         }
-        Ok(Scene { name, mesh, materials, warnings })
+        Ok(Scene { name, mesh, materials, warnings, sources: Vec::new() })
     }
 
     /// Sets the emission of every material called `name`.

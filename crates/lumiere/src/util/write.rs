@@ -3,6 +3,7 @@
 //! flight (so a process that must exit at once can remove them), and those of dead processes are
 //! cleaned up by the next run.
 
+use crate::error::shown_path;
 use std::fs::{self, File, OpenOptions};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -99,7 +100,7 @@ fn resolve_link(path: &Path) -> Result<Option<PathBuf>> {
         Ok(target) => Ok(Some(target)),
         Err(_) => Err(Error::invalid(format!(
             "{}: is a link to nothing lumiere can replace (dangling, or a pipe or device); give a file name",
-            path.display()
+            shown_path(path)
         ))),
     }
 }
@@ -108,12 +109,12 @@ fn resolve_link(path: &Path) -> Result<Option<PathBuf>> {
 fn check_target(path: &Path) -> Result<()> {
     let Ok(metadata) = fs::metadata(path) else { return Ok(()) };
     if metadata.is_dir() {
-        return Err(Error::invalid(format!("{}: is a directory, expected a file name", path.display())));
+        return Err(Error::invalid(format!("{}: is a directory, expected a file name", shown_path(path))));
     }
     if !metadata.is_file() {
         return Err(Error::invalid(format!(
             "{}: exists and is not a regular file (a device, FIFO or socket); lumiere writes only regular files",
-            path.display()
+            shown_path(path)
         )));
     }
     Ok(())
@@ -124,7 +125,7 @@ fn check_target(path: &Path) -> Result<()> {
 fn temp_path(path: &Path) -> Result<PathBuf> {
     static COUNTER: AtomicU64 = AtomicU64::new(0);
     if path.file_name().is_none() {
-        return Err(Error::invalid(format!("{}: output path has no file name", path.display())));
+        return Err(Error::invalid(format!("{}: output path has no file name", shown_path(path))));
     }
     let n = COUNTER.fetch_add(1, Ordering::Relaxed);
     Ok(path.with_file_name(format!("{TEMP_PREFIX}{}-{n}{TEMP_SUFFIX}", std::process::id())))

@@ -1,6 +1,7 @@
 //! Where a render starts (a fresh film, or a checkpoint of the same scene and options) and how its
 //! state is saved.
 
+use lumiere::error::shown_path;
 use std::path::Path;
 
 use lumiere::render::RenderOptions;
@@ -45,14 +46,14 @@ impl Fingerprints {
         if checkpoint.scene_fingerprint != self.scene {
             return Err(Error::invalid(format!(
                 "{}: cannot resume: the checkpoint was rendered from a different scene (geometry, materials or --emission)",
-                path.display()
+                shown_path(path)
             )));
         }
         if checkpoint.options_fingerprint != hash_bytes(self.options.as_bytes()) || checkpoint.seed != self.seed {
             let differing = differing_options(&checkpoint.options, &self.options);
             return Err(Error::invalid(format!(
                 "{}: cannot resume: the checkpoint was rendered with other options: {}; only --spp and the budgets may change",
-                path.display(),
+                shown_path(path),
                 differing.join(", ")
             )));
         }

@@ -45,6 +45,7 @@ fn render(args: &RenderArgs, threads: usize) -> Result<u8> {
     let load_start = Instant::now();
     let scene = load_scene(args)?;
     let load_ms = load_start.elapsed().as_secs_f64() * 1e3;
+    paths::check_against_sources(args, &scene)?;
     let camera = camera::from_args(args, &scene)?;
     let options = options::from_args(args);
     let fingerprints = Fingerprints::new(&scene, &options, &camera);

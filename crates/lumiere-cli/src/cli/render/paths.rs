@@ -3,9 +3,11 @@
 //! existing output must be a regular file. Temporary files that killed runs left beside the
 //! outputs are removed.
 
+use lumiere::error::shown_path;
 use std::path::{Path, PathBuf};
 
 use lumiere::image_io::check_output_path;
+use lumiere::scene::Scene;
 use lumiere::util::write::{check_writable, remove_stale_temporaries};
 use lumiere::{Error, Result};
 
@@ -45,7 +47,7 @@ pub fn check(args: &RenderArgs) -> Result<()> {
     if !args.aov.is_empty() && !exr {
         return Err(Error::invalid(format!(
             "{}: --aov writes extra channels, which only an .exr output can hold",
-            args.output.display()
+            shown_path(&args.output)
         )));
     }
     for output in &outputs[1..] {
@@ -71,12 +73,30 @@ pub fn check(args: &RenderArgs) -> Result<()> {
     Ok(())
 }
 
+/// Refuses an output that is one of the files the loaded scene was read from: its material
+/// libraries and textures.
+pub fn check_against_sources(args: &RenderArgs, scene: &Scene) -> Result<()> {
+    let textures = scene.materials.iter().filter_map(|m| m.map_kd.as_deref());
+    let sources: Vec<&Path> = scene.sources.iter().map(PathBuf::as_path).chain(textures).collect();
+    let outputs = [Some(&args.output), args.stats_json.as_ref(), args.checkpoint.as_ref()];
+    for output in outputs.into_iter().flatten() {
+        if let Some(source) = sources.iter().find(|source| same_file(output, source)) {
+            return Err(Error::invalid(format!(
+                "{}: the output would overwrite {}, which the scene reads",
+                shown_path(output),
+                shown_path(source)
+            )));
+        }
+    }
+    Ok(())
+}
+
 fn clash(a: &Named, b: &Named, why: &str) -> Error {
     Error::invalid(format!(
         "{} ({}) and {} ({}) are the same file: {why}",
-        a.path.display(),
+        shown_path(a.path),
         a.flag,
-        b.path.display(),
+        shown_path(b.path),
         b.flag
     ))
 }

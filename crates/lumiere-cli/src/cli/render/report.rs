@@ -1,6 +1,7 @@
 //! What a render tells the user: a progress bar on a terminal, one closing line, and on request a
 //! JSON file of statistics.
 
+use lumiere::error::shown_path;
 use std::io::IsTerminal;
 use std::path::Path;
 
@@ -47,7 +48,7 @@ pub fn summary(options: &RenderOptions, camera: &Camera, output: &RenderOutput, 
         output.stats.elapsed.as_secs_f64() * 1e3,
         output.stats.rays,
         output.stats.mrays_per_second(),
-        path.display()
+        shown_path(path)
     ));
     if output.film.samples == 0 && output.stop == StopReason::TimeBudget {
         output::warn(

@@ -35,12 +35,16 @@ pub struct ObjScene {
     pub mesh: TriangleMesh,
     pub materials: Vec<Material>,
     pub warnings: Vec<String>,
+    /// The MTL files read, as resolved.
+    pub material_files: Vec<std::path::PathBuf>,
 }
 
 impl ObjScene {
     /// The scene these parts make, named `name` in messages (see [`Scene::from_parts`]).
     pub fn into_scene(self, name: String) -> Result<Scene> {
-        Scene::from_parts(name, self.mesh, self.materials, self.warnings)
+        let mut scene = Scene::from_parts(name, self.mesh, self.materials, self.warnings)?;
+        scene.sources = self.material_files;
+        Ok(scene)
     }
 }
 
@@ -168,7 +172,12 @@ fn parse_obj_within(
     warn_dropped(&mut table, name, texcoords, "texture-coordinate", "texture coordinates", kind);
     warn_dropped(&mut table, name, normals, "normal", "normals", "normal indices out of range");
     let warnings = std::mem::take(&mut table.warnings).finish();
-    Ok(ObjScene { mesh: merge(&parsed, material_ids), materials: table.materials, warnings })
+    Ok(ObjScene {
+        mesh: merge(&parsed, material_ids),
+        materials: table.materials,
+        warnings,
+        material_files: table.files,
+    })
 }
 
 /// The memory the mesh of `vertices` and `triangles` needs while it is parsed and then rendered:

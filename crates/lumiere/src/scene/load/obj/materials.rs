@@ -30,6 +30,8 @@ const DEFAULT_NAME: &str = "default";
 pub(super) struct MaterialTable {
     pub(super) materials: Vec<Material>,
     pub(super) warnings: Warnings,
+    /// Every MTL file read, as resolved.
+    pub(super) files: Vec<PathBuf>,
     ids: HashMap<String, u32>,
     default_id: Option<u32>,
 }
@@ -116,6 +118,7 @@ impl MaterialTable {
 
     /// Adds the materials of one MTL file. A name defined twice keeps its first definition.
     fn add_file(&mut self, bytes: &[u8], path: &Path) {
+        self.files.push(path.to_path_buf());
         for material in parse_mtl(bytes, path, &mut self.warnings) {
             if self.ids.contains_key(&material.name) {
                 self.warnings.push(path, "materials defined again", || {
