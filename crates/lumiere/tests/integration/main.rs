@@ -10,4 +10,5 @@ mod module_graph;
 mod obj_loading;
 mod sampling;
 mod seams;
+mod textures;
 mod triangle;
