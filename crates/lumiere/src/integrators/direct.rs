@@ -68,7 +68,7 @@ impl Integrator for Direct {
         }
         let surface = world.surface(ray, &hit);
         let (frame, wo) = shading_frame(surface.ns, ray);
-        let receiver = Receiver { surface: &surface, bsdf: material.bsdf(), frame, wo };
+        let receiver = Receiver { surface: &surface, bsdf: material.bsdf(material.kd), frame, wo };
         // Every shadow ray leaves above the geometric surface (the others are skipped), so they
         // share one origin.
         let origin = surface.offset_origin(surface.ng);

@@ -12,6 +12,9 @@ pub struct Materials;
 impl Integrator for Materials {
     fn radiance(&self, world: &World, ray: &Ray, ctx: &mut SampleContext) -> Vec3 {
         ctx.rays += 1;
-        world.intersect(ray).map_or(Vec3::ZERO, |hit| world.material(hit.triangle).bsdf().albedo())
+        world.intersect(ray).map_or(Vec3::ZERO, |hit| {
+            let material = world.material(hit.triangle);
+            material.bsdf(material.kd).albedo()
+        })
     }
 }

@@ -19,7 +19,7 @@ impl Integrator for Shadows {
             return material.ke;
         }
         let surface = world.surface(ray, &hit);
-        let bsdf = material.bsdf();
+        let bsdf = material.bsdf(material.kd);
         let (frame, wo) = shading_frame(surface.ns, ray);
         let mut sum = Vec3::ZERO;
         for light in world.lights().lights() {

@@ -2,6 +2,7 @@
 
 mod common;
 
+mod bsdfs;
 mod bvh;
 mod camera;
 mod estimators;
