@@ -34,6 +34,7 @@ pub mod render;
 pub mod sampler;
 pub mod sampling;
 pub mod scene;
+pub mod textures;
 pub mod util;
 pub mod world;
 

@@ -6,22 +6,31 @@ use glam::{Vec2, Vec3};
 use crate::accel::{BuildPreset, Bvh4, Hit, Isa, OriginBatch, Region};
 use crate::geometry::surface::SurfacePoint;
 use crate::lights::LightSet;
-use crate::materials::Material;
+use crate::materials::{Material, MaterialBsdf, MaterialKind};
 use crate::math::Ray;
 use crate::scene::Scene;
 use crate::scene::mesh::NO_INDEX;
+use crate::textures::{TextureId, TextureSet};
 
 pub struct World {
     scene: Scene,
     /// The 4-wide BVH; the binary tree it was collapsed from is dropped to save memory.
     bvh: Bvh4,
     lights: LightSet,
+    /// Each material's kind, mapped once from its statements.
+    kinds: Vec<MaterialKind>,
+    /// Each material's diffuse texture, decoded once.
+    texture_of_material: Vec<Option<TextureId>>,
+    textures: TextureSet,
+    /// What could not be derived (textures that failed to load), for the user to see.
+    warnings: Vec<String>,
     /// The instruction set, detected once here; the accel above was chosen from it.
     isa: Isa,
 }
 
 impl World {
-    /// Builds the BVH over the scene's triangles and derives its lights.
+    /// Builds the BVH over the scene's triangles, derives its lights and the kind of each material,
+    /// and decodes its textures.
     pub fn new(scene: Scene, preset: BuildPreset) -> World {
         let isa = Isa::detect();
         // The one place the accel is chosen by ISA. The 4-wide SSE kernel is the only one so far, and
@@ -32,7 +41,10 @@ impl World {
             }
         };
         let lights = LightSet::new(&scene);
-        World { scene, bvh, lights, isa }
+        let kinds = scene.materials.iter().map(Material::kind).collect();
+        let (texture_of_material, textures, warnings) =
+            TextureSet::for_materials(scene.materials.iter().map(|m| m.map_kd.as_deref()));
+        World { scene, bvh, lights, kinds, texture_of_material, textures, warnings, isa }
     }
 
     pub fn scene(&self) -> &Scene {
@@ -45,6 +57,23 @@ impl World {
 
     pub fn lights(&self) -> &LightSet {
         &self.lights
+    }
+
+    /// Problems met while deriving the world (a texture that could not be decoded).
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+
+    /// The scattering function at a surface point: its material's kind with the colour of its
+    /// texture there, or its `Kd`.
+    #[inline]
+    pub fn bsdf(&self, surface: &SurfacePoint) -> MaterialBsdf {
+        let id = surface.material as usize;
+        let base = match self.texture_of_material[id] {
+            Some(texture) => self.textures.sample(texture, surface.uv),
+            None => self.scene.materials[id].kd,
+        };
+        self.kinds[id].bsdf(base)
     }
 
     /// The instruction set detected when the world was built.
@@ -99,10 +128,11 @@ impl World {
         let w = 1.0 - hit.u - hit.v;
         let p = w * p0 + hit.u * p1 + hit.v * p2;
         let geometric = (p1 - p0).cross(p2 - p0).normalize_or_zero();
-        let ng = if geometric.dot(ray.dir) > 0.0 { -geometric } else { geometric };
+        let front_face = geometric.dot(ray.dir) <= 0.0;
+        let ng = if front_face { geometric } else { -geometric };
         let ns = self.interpolated_normal(id, w, hit.u, hit.v).map_or(ng, |n| if n.dot(ng) < 0.0 { -n } else { n });
         let uv = self.interpolated_texcoord(id, w, hit.u, hit.v);
-        SurfacePoint { p, ng, ns, uv, triangle: hit.triangle, material: mesh.material_ids[id] }
+        SurfacePoint { p, ng, ns, uv, triangle: hit.triangle, material: mesh.material_ids[id], front_face }
     }
 
     fn interpolated_normal(&self, id: usize, w: f32, u: f32, v: f32) -> Option<Vec3> {

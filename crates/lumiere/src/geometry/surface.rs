@@ -20,6 +20,10 @@ pub struct SurfacePoint {
     pub triangle: u32,
     /// Index of the triangle's material in the scene.
     pub material: u32,
+    /// Whether the ray arrived on the side the triangle's winding faces (its front): `ng` and `ns`
+    /// are turned towards the ray, so a transmissive material needs this to tell inside from
+    /// outside.
+    pub front_face: bool,
 }
 
 impl SurfacePoint {

@@ -62,7 +62,6 @@ impl Integrator for Direct {
     fn radiance(&self, world: &World, ray: &Ray, ctx: &mut SampleContext) -> Vec3 {
         ctx.rays += 1;
         let Some(hit) = world.intersect(ray) else { return Vec3::ZERO };
-        let material = world.material(hit.triangle);
         // A light seen from the side it faces shows its emission; from behind it is a surface.
         let emitted = world.emitted(hit.triangle, ray);
         if emitted != Vec3::ZERO {
@@ -70,7 +69,7 @@ impl Integrator for Direct {
         }
         let surface = world.surface(ray, &hit);
         let (frame, wo) = shading_frame(surface.ns, ray);
-        let receiver = Receiver { surface: &surface, bsdf: material.bsdf(), frame, wo };
+        let receiver = Receiver { surface: &surface, bsdf: world.bsdf(&surface), frame, wo };
         // Every shadow ray leaves above the geometric surface (the others are skipped), so they
         // share one origin.
         let origin = surface.offset_origin(surface.ng);

@@ -138,15 +138,20 @@ impl Integrator for Path {
                 break;
             }
 
-            let material = world.material(hit.triangle);
-            let frame = Frame::from_normal(surface.ns);
+            let bsdf = world.bsdf(&surface);
+            // Opaque lobes scatter on the viewer's side, where `ns` is turned; a transmissive one
+            // needs its own orientation (`wo.z < 0` means inside), so its frame keeps the normal's.
+            let normal = if bsdf.transmits() && !surface.front_face { -surface.ns } else { surface.ns };
+            let frame = Frame::from_normal(normal);
             let wo = frame.to_local(-ray.dir.normalize());
-            let vertex = Vertex { surface: &surface, bsdf: material.bsdf(), frame, wo };
+            let vertex = Vertex { surface: &surface, bsdf, frame, wo };
 
-            // Next-event estimation: one point on a light chosen by power.
+            // Next-event estimation: one point on a light chosen by power (not through a delta lobe,
+            // which no light point can hit).
             let (u_light, u_point) = (ctx.stream.next_1d(), ctx.stream.next_2d());
             let sample = match self.strategy {
                 PathStrategy::BsdfOnly => None,
+                _ if bsdf.is_delta() => None,
                 _ => lights.sample_li(SELECTION, surface.p, u_light, u_point),
             };
             if let Some(sample) = sample {

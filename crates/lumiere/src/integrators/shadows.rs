@@ -14,14 +14,13 @@ impl Integrator for Shadows {
     fn radiance(&self, world: &World, ray: &Ray, ctx: &mut SampleContext) -> Vec3 {
         ctx.rays += 1;
         let Some(hit) = world.intersect(ray) else { return Vec3::ZERO };
-        let material = world.material(hit.triangle);
         // A light seen from the side it faces shows its emission; from behind it is a surface.
         let emitted = world.emitted(hit.triangle, ray);
         if emitted != Vec3::ZERO {
             return emitted;
         }
         let surface = world.surface(ray, &hit);
-        let bsdf = material.bsdf();
+        let bsdf = world.bsdf(&surface);
         let (frame, wo) = shading_frame(surface.ns, ray);
         let mut sum = Vec3::ZERO;
         for light in world.lights().lights() {

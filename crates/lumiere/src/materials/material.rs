@@ -1,33 +1,123 @@
 //! The format-neutral description of a surface, as scene loaders fill it (from MTL statements
-//! today). Integrators never read it directly: they ask it for its [`Bsdf`](super::Bsdf).
+//! today), and the one mapping from it to a kind of BSDF ([`Material::kind`]). Integrators never
+//! read the statements directly: they ask the material for its [`MaterialBsdf`].
+//!
+//! docs/MATERIALS.md lists, with reasons, which statements are honoured and which are not.
 
 use glam::Vec3;
 
-use super::Lambert;
+use super::conductor::is_smooth;
+use super::microfacet::MIN_ALPHA;
+use super::{Conductor, Dielectric, Lambert, MaterialBsdf, Mirror, Plastic};
 use std::path::PathBuf;
+
+/// The index of refraction of a transmissive material whose file gives none usable (ordinary
+/// glass). `Ni 1` counts as none: it is both our default and what exporters write when no index
+/// was set, and a glass of index 1 would be invisible.
+pub const DEFAULT_IOR: f32 = 1.5;
+
+/// The Phong exponent from which a specular layer counts as smooth: 1000, the top of the MTL
+/// format's range (`Ns` 0–1000), which exporters write for "perfectly smooth".
+pub const SMOOTH_NS: f32 = 1000.0;
+
+/// The specular reflectance of a non-metal in the PBR extension (`Pm < 0.5`): 4%, the normal
+/// reflectance of an interface of index 1.5, as in glTF and Blender's Principled BSDF.
+const PBR_DIELECTRIC_SPECULAR: f32 = 0.04;
+
+/// The range of `Ni` the MTL format allows; values outside it (and `Ni 1`) use [`DEFAULT_IOR`].
+const IOR_RANGE: std::ops::RangeInclusive<f32> = 0.001..=10.0;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
     pub name: String,
-    /// Diffuse reflectance.
+    /// Diffuse reflectance (MTL `Kd`); also the base colour of metals (`Pm`), i.e. their `F0`.
     pub kd: Vec3,
-    /// Specular reflectance.
+    /// Specular reflectance (MTL `Ks`): the specular layer of a plastic, or a mirror's colour.
     pub ks: Vec3,
-    /// Phong exponent.
+    /// Phong exponent (MTL `Ns`, 0–1000): the specular layer's sharpness, mapped to GGX roughness
+    /// by [`alpha_from_ns`].
     pub ns: f32,
     /// Emitted radiance; a non-zero value makes every triangle with this material a light.
     pub ke: Vec3,
-    /// Diffuse texture, resolved relative to the MTL file.
+    /// Diffuse texture, resolved relative to the MTL file; where it decodes, its value at the hit
+    /// replaces `kd` as the base colour.
     pub map_kd: Option<PathBuf>,
-    /// Index of refraction.
+    /// Index of refraction (MTL `Ni`) of a transmissive material.
     pub ni: f32,
-    /// Opacity (`d`), 1 = opaque.
+    /// Opacity (`d`, or `1 − Tr`), 1 = opaque. Below 1 together with an explicit `Ni`, the surface
+    /// is glass; otherwise it is not honoured (no alpha blending or cutouts yet).
     pub dissolve: f32,
+    /// MTL illumination model: 0–1 switch the specular layer off, 2 on, 3/5/8 make it a mirror,
+    /// 4/6/7/9 make the surface glass (see [`Material::kind`]).
     pub illum: u32,
+    /// Transmission filter (MTL `Tf`): the colour glass passes, per refraction; default white.
+    pub tf: Vec3,
+    /// Metallic weight (MTL PBR extension `Pm`, 0–1); `None` when the file does not say.
+    /// Its presence, or that of `roughness`, selects the PBR mapping.
+    pub metallic: Option<f32>,
+    /// Perceptual roughness (MTL PBR extension `Pr`, 0–1); GGX `α = Pr²`. `None` when the file
+    /// does not say.
+    pub roughness: Option<f32>,
+}
+
+/// The kind of scattering a [`Material`] stands for, with its parameters resolved from the file's
+/// statements; the base colour (`kd` or a texture's value at the hit) is supplied when the BSDF is
+/// built, by [`MaterialKind::bsdf`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum MaterialKind {
+    /// Diffuse reflection of the base colour.
+    Lambert,
+    /// The base colour, diffuse, under a GGX specular layer of reflectance `ks` and roughness `alpha`.
+    Plastic { ks: Vec3, alpha: f32 },
+    /// A metal whose reflectance at normal incidence is the base colour, with GGX roughness
+    /// `alpha`; a perfect [`Mirror`] of the base colour when `alpha` is below [`MIN_ALPHA`].
+    Conductor { alpha: f32 },
+    /// A perfect mirror of reflectance `f0` at normal incidence (from `Ks`); ignores the base colour.
+    Mirror { f0: Vec3 },
+    /// Smooth glass of index `eta` with transmission filter `tf`; ignores the base colour.
+    Dielectric { eta: f32, tf: Vec3 },
+}
+
+impl MaterialKind {
+    /// The BSDF of this kind with `base_colour` (the material's `kd`, or its texture's value at the
+    /// hit) as diffuse colour or metal `F0`.
+    #[inline]
+    pub fn bsdf(&self, base_colour: Vec3) -> MaterialBsdf {
+        match *self {
+            MaterialKind::Lambert => MaterialBsdf::Lambert(Lambert { reflectance: base_colour }),
+            MaterialKind::Plastic { ks, alpha } => MaterialBsdf::Plastic(Plastic::new(base_colour, ks, alpha)),
+            MaterialKind::Conductor { alpha } if is_smooth(alpha) => MaterialBsdf::Mirror(Mirror::new(base_colour)),
+            MaterialKind::Conductor { alpha } => MaterialBsdf::Conductor(Conductor::new(base_colour, alpha)),
+            MaterialKind::Mirror { f0 } => MaterialBsdf::Mirror(Mirror::new(f0)),
+            MaterialKind::Dielectric { eta, tf } => MaterialBsdf::Dielectric(Dielectric::new(eta, tf)),
+        }
+    }
+
+    /// A short name for messages and `info`: "lambert", "plastic", "conductor", "mirror", "dielectric".
+    pub fn name(&self) -> &'static str {
+        match self {
+            MaterialKind::Lambert => "lambert",
+            MaterialKind::Plastic { .. } => "plastic",
+            MaterialKind::Conductor { alpha } if is_smooth(*alpha) => "mirror",
+            MaterialKind::Conductor { .. } => "conductor",
+            MaterialKind::Mirror { .. } => "mirror",
+            MaterialKind::Dielectric { .. } => "dielectric",
+        }
+    }
+}
+
+/// The GGX roughness equivalent to a Blinn–Phong exponent: `α = √(2 / (Ns + 2))`, the
+/// Beckmann–Phong correspondence of Walter et al. 2007 (§5.2), used for GGX as is customary (the
+/// two distributions nearly agree at small α). `Ns ≤ 0` (or NaN) gives 1, the roughest; `Ns` 1000
+/// gives 0.045. The staircase's converter wrote `Ns = 2/α² − 2`, the inverse of this.
+#[inline]
+pub fn alpha_from_ns(ns: f32) -> f32 {
+    if ns.is_nan() || ns <= 0.0 { 1.0 } else { (2.0 / (ns + 2.0)).sqrt() }
 }
 
 impl Material {
-    /// The grey diffuse material used when a file names no material or its MTL cannot be read.
+    /// The grey diffuse material used when a file names no material or its MTL cannot be read;
+    /// also what loaders start a `newmtl` from.
     pub fn default_grey(name: &str) -> Self {
         Material {
             name: name.to_string(),
@@ -39,18 +129,72 @@ impl Material {
             ni: 1.0,
             dissolve: 1.0,
             illum: 1,
+            tf: Vec3::ONE,
+            metallic: None,
+            roughness: None,
         }
     }
 
     pub fn is_emissive(&self) -> bool {
         self.ke.max_element() > 0.0
     }
-}
 
-impl Material {
-    /// The scattering function of this material: Lambertian reflection of `kd` (the only lobe so far).
+    /// The one mapping from a material's statements to its kind of scattering, in this order
+    /// (the first rule that applies wins; docs/MATERIALS.md has the table and the reasons):
+    ///
+    /// 1. **PBR extension** (`Pm` or `Pr` given): `α = Pr²` (or from `Ns` without `Pr`); a metal
+    ///    ([`MaterialKind::Conductor`], base colour = `F0`) when `Pm ≥ 0.5`, otherwise a plastic
+    ///    with a 4% specular layer (the PBR dielectric). A threshold, not a blend: scanned
+    ///    materials are metal or not, and values in between come from filtered metallic maps,
+    ///    which MTL files do not carry here.
+    /// 2. **Glass** ([`MaterialKind::Dielectric`]): `illum` 4, 6, 7 or 9 (the transmissive
+    ///    illumination models), or `d < 1` with an explicit `Ni` (≠ 1); index `Ni`, or
+    ///    [`DEFAULT_IOR`] when absent, 1 or outside the format's range; filter `Tf`.
+    /// 3. **No specular layer** ([`MaterialKind::Lambert`]): `illum` 0 or 1 (the models without
+    ///    highlights; 1 is also what a material without `illum` gets), or `Ks` black.
+    /// 4. **Smooth specular**: `illum` 3, 5 or 8 (reflection on), or `Ns ≥` [`SMOOTH_NS`]: a
+    ///    [`MaterialKind::Mirror`] of `Ks` when the base colour is black (no `Kd`, no texture),
+    ///    otherwise a plastic whose layer is as smooth as GGX goes (`α =` [`MIN_ALPHA`]), so that
+    ///    a glossy paint keeps its colour.
+    /// 5. **Plastic**: `Kd` under a GGX layer of `Ks`, `α =` [`alpha_from_ns`]`(Ns)`.
+    pub fn kind(&self) -> MaterialKind {
+        if self.metallic.is_some() || self.roughness.is_some() {
+            let alpha = match self.roughness {
+                Some(pr) if !pr.is_nan() => pr.clamp(0.0, 1.0).powi(2),
+                _ => alpha_from_ns(self.ns),
+            };
+            return if self.metallic.is_some_and(|pm| pm >= 0.5) {
+                MaterialKind::Conductor { alpha }
+            } else {
+                MaterialKind::Plastic { ks: Vec3::splat(PBR_DIELECTRIC_SPECULAR), alpha }
+            };
+        }
+        let explicit_ior = IOR_RANGE.contains(&self.ni) && self.ni != 1.0;
+        if matches!(self.illum, 4 | 6 | 7 | 9) || (self.dissolve < 1.0 && explicit_ior) {
+            let eta = if explicit_ior { self.ni } else { DEFAULT_IOR };
+            return MaterialKind::Dielectric { eta, tf: self.tf.clamp(Vec3::ZERO, Vec3::ONE) };
+        }
+        let ks = self.ks.clamp(Vec3::ZERO, Vec3::ONE);
+        if matches!(self.illum, 0 | 1) || ks.max_element() <= 0.0 {
+            return MaterialKind::Lambert;
+        }
+        if matches!(self.illum, 3 | 5 | 8) || self.ns >= SMOOTH_NS {
+            let has_base_colour = self.kd.max_element() > 0.0 || self.map_kd.is_some();
+            return if has_base_colour {
+                MaterialKind::Plastic { ks, alpha: MIN_ALPHA }
+            } else {
+                MaterialKind::Mirror { f0: ks }
+            };
+        }
+        MaterialKind::Plastic { ks, alpha: alpha_from_ns(self.ns) }
+    }
+
+    /// The scattering function of this material at a point whose base colour is `base_colour`:
+    /// `kd`, or the value of the material's texture there (the caller looks it up). For the
+    /// all-Lambertian scenes of the lab this is `Lambert { reflectance: base_colour }`, bit for bit
+    /// what it always was.
     #[inline]
-    pub fn bsdf(&self) -> Lambert {
-        Lambert { reflectance: self.kd }
+    pub fn bsdf(&self, base_colour: Vec3) -> MaterialBsdf {
+        self.kind().bsdf(base_colour)
     }
 }

@@ -68,7 +68,7 @@ pub fn render_aovs(world: &World, camera: &Camera, options: &RenderOptions, aovs
                         let ray = camera.ray(x as f32 + offset.x, y as f32 + offset.y);
                         let Some(hit) = world.intersect(&ray) else { continue };
                         let surface = world.surface(&ray, &hit);
-                        sum[0] += world.material(hit.triangle).bsdf().albedo();
+                        sum[0] += world.bsdf(&surface).albedo();
                         sum[1] += surface.ns;
                         sum[2] += Vec3::splat(hit.t * ray.dir.length());
                     }

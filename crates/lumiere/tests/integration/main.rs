@@ -2,6 +2,7 @@
 
 mod common;
 
+mod bsdfs;
 mod bvh;
 mod camera;
 mod estimators;
@@ -12,4 +13,5 @@ mod obj_loading;
 mod path;
 mod sampling;
 mod seams;
+mod textures;
 mod triangle;

@@ -53,6 +53,9 @@ fn render(args: &RenderArgs, threads: usize) -> Result<u8> {
 
     let build_start = Instant::now();
     let world = World::new(scene, BuildPreset::Default);
+    for warning in world.warnings() {
+        output::warn(warning);
+    }
     let timings = Timings { load_ms, build_ms: build_start.elapsed().as_secs_f64() * 1e3 };
 
     report::warn_if_unlit(&world, &options);

@@ -2,7 +2,7 @@
 //! because a render with one wrong material is more useful than no render.
 
 use super::text::{Tokens, finite_f32, lines, quoted};
-use crate::error::shown_path;
+use crate::error::{quote, shown_path};
 use crate::materials::Material;
 use crate::scene::load::warnings::Warnings;
 use glam::Vec3;
@@ -13,11 +13,21 @@ use std::path::{Path, PathBuf};
 pub(super) fn parse_mtl(bytes: &[u8], path: &Path, warnings: &mut Warnings) -> Vec<Material> {
     let folder = path.parent().unwrap_or(Path::new(""));
     let mut materials: Vec<Material> = Vec::new();
+    // Per material, the keywords of the statements it carries that lumiere does not render.
+    let mut unsupported: Vec<Vec<String>> = Vec::new();
     for (i, line) in lines(bytes).enumerate() {
         let problem = match parse_statement(line, folder) {
             Ok(None) => continue,
             Ok(Some(Statement::NewMtl(name))) => {
                 materials.push(Material::default_grey(&name));
+                unsupported.push(Vec::new());
+                continue;
+            }
+            Ok(Some(Statement::Unsupported(keyword))) if !materials.is_empty() => {
+                let ignored = unsupported.last_mut().expect("one list per material");
+                if !ignored.contains(&keyword) {
+                    ignored.push(keyword);
+                }
                 continue;
             }
             Ok(Some(statement)) => match materials.last_mut() {
@@ -31,10 +41,21 @@ pub(super) fn parse_mtl(bytes: &[u8], path: &Path, warnings: &mut Warnings) -> V
         };
         warnings.push(path, "ignored MTL lines", || format!("{}:{}: {problem}; line ignored", shown_path(path), i + 1));
     }
+    for (material, ignored) in materials.iter().zip(&unsupported).filter(|(_, ignored)| !ignored.is_empty()) {
+        let keywords: Vec<String> = ignored.iter().map(quote).collect();
+        warnings.push(path, "unsupported MTL statements", || {
+            format!(
+                "{}: material {} uses statements lumiere does not render: {} (see docs/MATERIALS.md)",
+                shown_path(path),
+                quote(&material.name),
+                keywords.join(", ")
+            )
+        });
+    }
     materials
 }
 
-/// The MTL statements we keep; everything else (`Ka`, `map_Bump`, ...) is skipped silently.
+/// The MTL statements we keep; the others are named in one warning per material (`Ka` aside).
 enum Statement {
     NewMtl(String),
     Diffuse(Vec3),
@@ -45,6 +66,11 @@ enum Statement {
     Dissolve(f32),
     Illumination(u32),
     DiffuseMap(PathBuf),
+    TransmissionFilter(Vec3),
+    Metallic(f32),
+    Roughness(f32),
+    /// A statement lumiere does not render (bump maps, specular maps, ...), by keyword.
+    Unsupported(String),
 }
 
 impl Statement {
@@ -59,11 +85,18 @@ impl Statement {
             Statement::Dissolve(d) => material.dissolve = d,
             Statement::Illumination(illum) => material.illum = illum,
             Statement::DiffuseMap(path) => material.map_kd = Some(path),
+            Statement::TransmissionFilter(tf) => material.tf = tf,
+            Statement::Metallic(pm) => material.metallic = Some(pm),
+            Statement::Roughness(pr) => material.roughness = Some(pr),
+            Statement::Unsupported(_) => {}
         }
     }
 }
 
-/// `Ok(None)` for blank lines, comments and statements we do not use.
+/// Statements that are ignored without a word: ambient colour and its map.
+const HARMLESS: [&[u8]; 2] = [b"Ka", b"map_Ka"];
+
+/// `Ok(None)` for blank lines, comments and ambient terms.
 fn parse_statement(line: &[u8], folder: &Path) -> Result<Option<Statement>, String> {
     let mut tokens = Tokens::new(line);
     let Some(keyword) = tokens.next() else {
@@ -81,7 +114,12 @@ fn parse_statement(line: &[u8], folder: &Path) -> Result<Option<Statement>, Stri
         b"Tr" => Statement::Dissolve(1.0 - scalar(tokens)?),
         b"illum" => Statement::Illumination(integer(tokens)?),
         b"map_Kd" => Statement::DiffuseMap(texture_path(tokens, folder)?),
-        _ => return Ok(None),
+        b"Tf" => Statement::TransmissionFilter(color(tokens)?),
+        b"Pm" => Statement::Metallic(scalar(tokens)?),
+        b"Pr" => Statement::Roughness(scalar(tokens)?),
+        // Comments, and ambient terms, which have no meaning in a physically based renderer.
+        keyword if keyword.starts_with(b"#") || HARMLESS.contains(&keyword) => return Ok(None),
+        keyword => Statement::Unsupported(String::from_utf8_lossy(keyword).into_owned()),
     };
     Ok(Some(statement))
 }

@@ -1,0 +1,328 @@
+//! Textures: image files decoded once, when the world is built, into linear `f32` RGB (and alpha
+//! where the file has one), and looked up with bilinear filtering and repeat wrapping.
+//!
+//! * **Colour.** PNG and JPEG store sRGB-encoded values; each channel is decoded with the exact
+//!   sRGB curve (IEC 61966-2-1: linear below 0.04045, a 2.4 power above), so texture values are
+//!   reflectances, like `Kd`. Alpha is linear coverage and is kept as is, for later cutouts.
+//! * **Coordinates.** OBJ's texture origin is the bottom-left corner: `v = 0` is the *last* row of
+//!   the image, `v = 1` the first. Texel `(x, y)` (column, row from the top) has its centre at
+//!   `u = (x + ½) / width`, `v = 1 − (y + ½) / height`. Outside `[0, 1)` coordinates repeat; at the
+//!   borders, bilinear filtering blends with the opposite edge, as repeat wrapping implies.
+//!   NaN, infinite and huge coordinates read a valid texel and never panic.
+//! * **Loading.** [`TextureSet::load`] decodes every distinct file once, in parallel; a file that
+//!   cannot be read or decoded costs one warning naming it, and the materials that use it keep
+//!   their `Kd`. Image sizes are checked against [`MAX_TEXELS`] from the header, before decoding.
+//!
+//! How `World::new` is meant to use it (it does not yet; the world owns the wiring):
+//!
+//! ```ignore
+//! let (texture_of_material, textures, warnings) =
+//!     TextureSet::for_materials(scene.materials.iter().map(|m| m.map_kd.as_deref()));
+//! // at a hit with material m and interpolated texture coordinates uv:
+//! let base = match texture_of_material[m] { Some(id) => textures.sample(id, uv), None => material.kd };
+//! let bsdf = material.bsdf(base);
+//! ```
+
+use std::io::Cursor;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+use glam::{Vec2, Vec3};
+use image::{DynamicImage, ImageFormat, ImageReader, Limits};
+use rayon::prelude::*;
+
+/// The most texels (width × height) an image may have: 2²⁶, e.g. 8192 × 8192, which takes 1 GiB
+/// as `f32` RGBA. Larger images are refused from their header, before any decoding.
+pub const MAX_TEXELS: u64 = 1 << 26;
+
+/// The largest texture file read, in bytes (a compressed image of [`MAX_TEXELS`] is far smaller).
+pub const MAX_FILE_BYTES: u64 = 1 << 30;
+
+/// An image decoded to linear `f32` RGB, with its alpha channel when the file has one.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Texture {
+    width: u32,
+    height: u32,
+    /// Row-major from the top row of the image, as stored in the file.
+    rgb: Vec<Vec3>,
+    alpha: Option<Vec<f32>>,
+}
+
+impl Texture {
+    /// Decodes a PNG or JPEG file's bytes (the format is recognised from its content), refusing
+    /// images of more than [`MAX_TEXELS`] texels from the header alone. The error is a short
+    /// reason, without the file name.
+    pub fn decode(bytes: &[u8]) -> Result<Texture, String> {
+        let reader = ImageReader::new(Cursor::new(bytes)).with_guessed_format().map_err(|e| e.to_string())?;
+        let format = match reader.format() {
+            Some(format @ (ImageFormat::Png | ImageFormat::Jpeg)) => format,
+            Some(other) => return Err(format!("{other:?} images are not supported (PNG and JPEG are)")),
+            None => return Err("not a PNG or JPEG image".to_string()),
+        };
+        let (width, height) = reader.into_dimensions().map_err(|e| e.to_string())?;
+        check_size(width, height)?;
+        let mut reader = ImageReader::with_format(Cursor::new(bytes), format);
+        let mut limits = Limits::default();
+        limits.max_image_width = Some(width);
+        limits.max_image_height = Some(height);
+        // Room for the decoded image at 16 bits per channel and the decoder's own buffers.
+        limits.max_alloc = Some(MAX_TEXELS * 8 + (64 << 20));
+        reader.limits(limits);
+        let image = reader.decode().map_err(|e| e.to_string())?;
+        Ok(Texture::from_image(image))
+    }
+
+    /// A texture from linear texel values, row-major from the top row; `None` when the sizes do
+    /// not match, the image is empty, or it exceeds [`MAX_TEXELS`].
+    pub fn from_linear(width: u32, height: u32, rgb: Vec<Vec3>, alpha: Option<Vec<f32>>) -> Option<Texture> {
+        let n = width as u64 * height as u64;
+        let sizes_fit = rgb.len() as u64 == n && alpha.as_ref().is_none_or(|a| a.len() as u64 == n);
+        (sizes_fit && check_size(width, height).is_ok()).then_some(Texture { width, height, rgb, alpha })
+    }
+
+    /// Converts a decoded image, whatever its channels and depth, to linear RGB(A).
+    fn from_image(image: DynamicImage) -> Texture {
+        let (width, height) = (image.width(), image.height());
+        let has_alpha = image.color().has_alpha();
+        let mut alpha = Vec::new();
+        let rgb = if image.color().bytes_per_pixel() > image.color().channel_count() {
+            // 16 bits per channel (PNG): decode each value exactly.
+            let decode = |c: u16| srgb_to_linear(c as f32 / 65535.0);
+            let pixels = image.into_rgba16();
+            pixels
+                .pixels()
+                .map(|p| {
+                    if has_alpha {
+                        alpha.push(p[3] as f32 / 65535.0);
+                    }
+                    Vec3::new(decode(p[0]), decode(p[1]), decode(p[2]))
+                })
+                .collect()
+        } else {
+            let table = srgb_table();
+            let pixels = image.into_rgba8();
+            pixels
+                .pixels()
+                .map(|p| {
+                    if has_alpha {
+                        alpha.push(p[3] as f32 / 255.0);
+                    }
+                    Vec3::new(table[p[0] as usize], table[p[1] as usize], table[p[2] as usize])
+                })
+                .collect()
+        };
+        Texture { width, height, rgb, alpha: has_alpha.then_some(alpha) }
+    }
+
+    #[inline]
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    #[inline]
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// Whether the file had an alpha channel ([`Texture::sample_alpha`] is 1 everywhere otherwise).
+    #[inline]
+    pub fn has_alpha(&self) -> bool {
+        self.alpha.is_some()
+    }
+
+    /// The bytes the texels take in memory.
+    pub fn memory_bytes(&self) -> usize {
+        self.rgb.len() * std::mem::size_of::<Vec3>() + self.alpha.as_ref().map_or(0, |a| a.len() * 4)
+    }
+
+    /// The linear colour of texel `(x, y)`, column `x` and row `y` counted from the top of the
+    /// image as stored in the file; coordinates wrap around.
+    #[inline]
+    pub fn texel(&self, x: u32, y: u32) -> Vec3 {
+        self.rgb[self.index(x as i64, y as i64)]
+    }
+
+    /// The bilinearly filtered colour at texture coordinates `uv` (OBJ convention: `v = 0` is the
+    /// bottom of the image), with repeat wrapping.
+    #[inline]
+    pub fn sample(&self, uv: Vec2) -> Vec3 {
+        let [(i00, w00), (i10, w10), (i01, w01), (i11, w11)] = self.footprint(uv);
+        self.rgb[i00] * w00 + self.rgb[i10] * w10 + self.rgb[i01] * w01 + self.rgb[i11] * w11
+    }
+
+    /// The bilinearly filtered alpha at `uv`; 1 (opaque) for images without alpha.
+    #[inline]
+    pub fn sample_alpha(&self, uv: Vec2) -> f32 {
+        let Some(alpha) = &self.alpha else { return 1.0 };
+        self.footprint(uv).iter().map(|&(i, w)| alpha[i] * w).sum()
+    }
+
+    /// The four texels around `uv` and their bilinear weights (which sum to 1).
+    #[inline]
+    fn footprint(&self, uv: Vec2) -> [(usize, f32); 4] {
+        // Continuous texel coordinates, with texel centres at integers; rows from the top.
+        let x = wrap_unit(uv.x) * self.width as f32 - 0.5;
+        let y = (1.0 - wrap_unit(uv.y)) * self.height as f32 - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let (x0, y0) = (x0 as i64, y0 as i64);
+        [
+            (self.index(x0, y0), (1.0 - fx) * (1.0 - fy)),
+            (self.index(x0 + 1, y0), fx * (1.0 - fy)),
+            (self.index(x0, y0 + 1), (1.0 - fx) * fy),
+            (self.index(x0 + 1, y0 + 1), fx * fy),
+        ]
+    }
+
+    /// The storage index of texel `(x, y)`, wrapped into the image.
+    #[inline]
+    fn index(&self, x: i64, y: i64) -> usize {
+        let x = x.rem_euclid(self.width as i64) as usize;
+        let y = y.rem_euclid(self.height as i64) as usize;
+        y * self.width as usize + x
+    }
+}
+
+/// `t` wrapped into `[0, 1]` (repeat); 0 for NaN and infinities. The result can be exactly 1 for
+/// tiny negative `t` (`1 − 1e-9` rounds up), which the index wrapping handles.
+#[inline]
+fn wrap_unit(t: f32) -> f32 {
+    if t.is_finite() { t - t.floor() } else { 0.0 }
+}
+
+/// Refuses empty images and those of more than [`MAX_TEXELS`] texels.
+fn check_size(width: u32, height: u32) -> Result<(), String> {
+    let texels = width as u64 * height as u64;
+    if texels == 0 {
+        return Err(format!("the image is {width}×{height}, without pixels"));
+    }
+    if texels > MAX_TEXELS {
+        return Err(format!(
+            "the image is {width}×{height} = {texels} pixels, over the limit of {MAX_TEXELS} ({} MiB as linear RGBA); \
+             refusing to decode it",
+            (MAX_TEXELS * 16) >> 20
+        ));
+    }
+    Ok(())
+}
+
+/// The exact sRGB decoding curve (IEC 61966-2-1) for an encoded value in `[0, 1]`.
+#[inline]
+pub fn srgb_to_linear(c: f32) -> f32 {
+    let c = c as f64;
+    let linear = if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) };
+    linear as f32
+}
+
+/// The linear values of the 256 8-bit sRGB codes, computed once.
+fn srgb_table() -> &'static [f32; 256] {
+    static TABLE: OnceLock<[f32; 256]> = OnceLock::new();
+    TABLE.get_or_init(|| std::array::from_fn(|code| srgb_to_linear(code as f32 / 255.0)))
+}
+
+/// Names one texture of a [`TextureSet`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct TextureId(u32);
+
+impl TextureId {
+    /// The texture's position in its set.
+    #[inline]
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+}
+
+/// The decoded textures of a scene, each file once.
+#[derive(Clone, Debug, Default)]
+pub struct TextureSet {
+    textures: Vec<Texture>,
+    paths: Vec<PathBuf>,
+}
+
+impl TextureSet {
+    /// Decodes every distinct path of `paths` once (files in parallel) and returns the textures
+    /// that decoded, with one warning for each path that did not, in the order of `paths`:
+    /// `texture "PATH": REASON; the material's Kd is used instead`.
+    pub fn load<P: AsRef<Path> + Sync>(paths: &[P]) -> (TextureSet, Vec<String>) {
+        let mut distinct: Vec<&Path> = Vec::new();
+        for path in paths {
+            if !distinct.contains(&path.as_ref()) {
+                distinct.push(path.as_ref());
+            }
+        }
+        let decoded: Vec<Result<Texture, String>> = distinct.par_iter().map(|path| read_texture(path)).collect();
+        let mut set = TextureSet::default();
+        let mut warnings = Vec::new();
+        for (path, result) in distinct.into_iter().zip(decoded) {
+            match result {
+                Ok(texture) => {
+                    set.textures.push(texture);
+                    set.paths.push(path.to_path_buf());
+                }
+                Err(reason) => warnings
+                    .push(format!("texture \"{}\": {reason}; the material's Kd is used instead", path.display())),
+            }
+        }
+        (set, warnings)
+    }
+
+    /// The textures of a scene's materials: give each material's diffuse texture path (`map_kd`,
+    /// already resolved relative to its MTL file), get for each material the id of its texture
+    /// (`None` for no texture or one that failed), the set, and the warnings of [`TextureSet::load`].
+    pub fn for_materials<'a>(
+        map_kd: impl IntoIterator<Item = Option<&'a Path>>,
+    ) -> (Vec<Option<TextureId>>, TextureSet, Vec<String>) {
+        let map_kd: Vec<Option<&Path>> = map_kd.into_iter().collect();
+        let paths: Vec<&Path> = map_kd.iter().flatten().copied().collect();
+        let (set, warnings) = TextureSet::load(&paths);
+        let ids = map_kd.iter().map(|path| path.and_then(|p| set.id_of(p))).collect();
+        (ids, set, warnings)
+    }
+
+    /// The id of the texture decoded from `path`, if it decoded.
+    pub fn id_of(&self, path: &Path) -> Option<TextureId> {
+        self.paths.iter().position(|p| p == path).map(|i| TextureId(i as u32))
+    }
+
+    #[inline]
+    pub fn get(&self, id: TextureId) -> &Texture {
+        &self.textures[id.index()]
+    }
+
+    /// The file texture `id` was decoded from.
+    pub fn path(&self, id: TextureId) -> &Path {
+        &self.paths[id.index()]
+    }
+
+    /// The bilinearly filtered colour of texture `id` at `uv` (see [`Texture::sample`]).
+    #[inline]
+    pub fn sample(&self, id: TextureId, uv: Vec2) -> Vec3 {
+        self.get(id).sample(uv)
+    }
+
+    pub fn len(&self) -> usize {
+        self.textures.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.textures.is_empty()
+    }
+
+    /// The bytes all texels take in memory.
+    pub fn memory_bytes(&self) -> usize {
+        self.textures.iter().map(Texture::memory_bytes).sum()
+    }
+}
+
+/// Reads and decodes one texture file; the error is a reason without the file name.
+fn read_texture(path: &Path) -> Result<Texture, String> {
+    let metadata = std::fs::metadata(path).map_err(|e| e.to_string())?;
+    if !metadata.is_file() {
+        return Err("not a regular file".to_string());
+    }
+    if metadata.len() > MAX_FILE_BYTES {
+        return Err(format!("the file has {} bytes, over the limit of {MAX_FILE_BYTES}", metadata.len()));
+    }
+    let bytes = crate::util::read::read_regular_file(path).map_err(|e| e.to_string())?;
+    Texture::decode(&bytes)
+}

@@ -1,0 +1,251 @@
+//! Textures: PNG and JPEG files written here with the `image` crate, decoded to linear values with
+//! the exact sRGB curve, looked up bilinearly with repeat wrapping and OBJ's bottom-left origin;
+//! files that cannot be used cost one warning each and no texture.
+
+use std::path::{Path, PathBuf};
+
+use crate::common::TempDir;
+use glam::{Vec2, Vec3};
+use image::{ImageFormat, Rgb, RgbImage, Rgba, RgbaImage};
+use lumiere::textures::{MAX_TEXELS, Texture, TextureSet, srgb_to_linear};
+
+/// The sRGB decoding curve, written independently in f64.
+fn linear(code: u8) -> f32 {
+    let c = code as f64 / 255.0;
+    (if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }) as f32
+}
+
+fn linear_rgb(p: [u8; 3]) -> Vec3 {
+    Vec3::new(linear(p[0]), linear(p[1]), linear(p[2]))
+}
+
+/// The texture coordinates of the centre of texel (x, y), row y counted from the top of the image.
+fn centre(x: u32, y: u32, width: u32, height: u32) -> Vec2 {
+    Vec2::new((x as f32 + 0.5) / width as f32, 1.0 - (y as f32 + 0.5) / height as f32)
+}
+
+fn close(a: Vec3, b: Vec3, tolerance: f32) -> bool {
+    (a - b).abs().max_element() <= tolerance
+}
+
+/// A 4 × 3 image whose every texel has its own colour, with codes on both sides of the sRGB
+/// curve's linear segment.
+fn test_image() -> RgbImage {
+    RgbImage::from_fn(4, 3, |x, y| {
+        Rgb([(x * 60 + y * 7) as u8, (255 - x * 50 - y * 30) as u8, [0, 10, 128][y as usize]])
+    })
+}
+
+fn load_one(path: &Path) -> Texture {
+    let (set, warnings) = TextureSet::load(&[path]);
+    assert!(warnings.is_empty(), "{warnings:?}");
+    set.get(set.id_of(path).unwrap()).clone()
+}
+
+#[test]
+fn png_texel_centres_read_the_srgb_decoded_values() {
+    let dir = TempDir::new("textures-png");
+    let image = test_image();
+    let path = dir.path("grid.png");
+    image.save_with_format(&path, ImageFormat::Png).unwrap();
+    let texture = load_one(&path);
+    assert_eq!((texture.width(), texture.height(), texture.has_alpha()), (4, 3, false));
+    for (x, y, p) in image.enumerate_pixels() {
+        let expected = linear_rgb(p.0);
+        assert!(close(texture.texel(x, y), expected, 1e-7), "texel ({x}, {y})");
+        let got = texture.sample(centre(x, y, 4, 3));
+        assert!(close(got, expected, 1e-5), "centre of ({x}, {y}): {got} vs {expected}");
+    }
+    // Known values of the curve: its ends, the linear segment, and mid-grey.
+    assert_eq!(srgb_to_linear(0.0), 0.0);
+    assert_eq!(srgb_to_linear(1.0), 1.0);
+    assert!((srgb_to_linear(10.0 / 255.0) - 10.0 / 255.0 / 12.92).abs() < 1e-9);
+    assert!((srgb_to_linear(128.0 / 255.0) - 0.215_860_5).abs() < 1e-6);
+}
+
+#[test]
+fn bilinear_filtering_repeat_wrapping_and_the_bottom_left_origin() {
+    let dir = TempDir::new("textures-filter");
+    let image = test_image();
+    let path = dir.path("grid.png");
+    image.save_with_format(&path, ImageFormat::Png).unwrap();
+    let texture = load_one(&path);
+    let texel = |x: u32, y: u32| linear_rgb(image.get_pixel(x, y).0);
+    // Midway between two texel centres, horizontally and vertically: their mean.
+    let between = (centre(1, 1, 4, 3) + centre(2, 1, 4, 3)) / 2.0;
+    assert!(close(texture.sample(between), (texel(1, 1) + texel(2, 1)) / 2.0, 1e-5));
+    let between = (centre(3, 0, 4, 3) + centre(3, 1, 4, 3)) / 2.0;
+    assert!(close(texture.sample(between), (texel(3, 0) + texel(3, 1)) / 2.0, 1e-5));
+    // At the centre of four texels: their mean.
+    let middle = (centre(0, 1, 4, 3) + centre(1, 2, 4, 3)) / 2.0;
+    let mean = (texel(0, 1) + texel(1, 1) + texel(0, 2) + texel(1, 2)) / 4.0;
+    assert!(close(texture.sample(middle), mean, 1e-5));
+    // A quarter of the way: weights 3/4 and 1/4.
+    let quarter = centre(1, 1, 4, 3) + Vec2::new(0.25 / 4.0, 0.0);
+    assert!(close(texture.sample(quarter), texel(1, 1) * 0.75 + texel(2, 1) * 0.25, 1e-5));
+    // Repeat: u = 1.25 and u = -0.75 read u = 0.25; v likewise.
+    for v in [0.1f32, 0.5, 0.77] {
+        let at = texture.sample(Vec2::new(0.25, v));
+        assert!(close(texture.sample(Vec2::new(1.25, v)), at, 1e-5), "v {v}");
+        assert!(close(texture.sample(Vec2::new(-0.75, v)), at, 1e-5), "v {v}");
+        assert!(close(texture.sample(Vec2::new(0.25, v + 3.0)), at, 1e-5), "v {v}");
+    }
+    // Across the seam, the last column blends with the first.
+    let seam = texture.sample(Vec2::new(1.0, centre(0, 1, 4, 3).y));
+    assert!(close(seam, (texel(3, 1) + texel(0, 1)) / 2.0, 1e-5));
+    // OBJ's origin is the bottom-left: the bottom row's centres are at v = 0.5/3, the top's at
+    // v = 1 − 0.5/3.
+    for x in 0..4 {
+        let u = (x as f32 + 0.5) / 4.0;
+        assert!(close(texture.sample(Vec2::new(u, 0.5 / 3.0)), texel(x, 2), 1e-5), "bottom row, x {x}");
+        assert!(close(texture.sample(Vec2::new(u, 1.0 - 0.5 / 3.0)), texel(x, 0), 1e-5), "top row, x {x}");
+        // Just above v = 0 the bottom row dominates.
+        let low = texture.sample(Vec2::new(u, 0.01));
+        assert!((low - texel(x, 2)).length() < (low - texel(x, 0)).length(), "v = 0.01 leans to the bottom row");
+    }
+}
+
+#[test]
+fn absurd_coordinates_read_a_texel_without_panicking() {
+    let texture = Texture::from_linear(3, 2, (0..6).map(|i| Vec3::splat(i as f32 / 5.0)).collect(), None).unwrap();
+    let values = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, 1e30, -1e30, 3e9, -1e-30, f32::MAX, f32::MIN, -0.0, 1.0];
+    for u in values {
+        for v in values {
+            let c = texture.sample(Vec2::new(u, v));
+            assert!(c.is_finite() && c.min_element() >= 0.0 && c.max_element() <= 1.0 + 1e-6, "({u}, {v}) → {c}");
+            assert_eq!(texture.sample_alpha(Vec2::new(u, v)), 1.0);
+        }
+    }
+    assert!(Texture::from_linear(3, 2, vec![Vec3::ZERO; 5], None).is_none(), "sizes must match");
+    assert!(Texture::from_linear(0, 0, vec![], None).is_none(), "empty");
+}
+
+#[test]
+fn jpeg_textures_decode_to_linear_values() {
+    let dir = TempDir::new("textures-jpeg");
+    // Two flat 8 × 8 blocks (JPEG's unit), which survive compression at quality 100 almost exactly.
+    let (left, right) = ([200u8, 120, 40], [30u8, 90, 220]);
+    let image = RgbImage::from_fn(16, 8, |x, _| Rgb(if x < 8 { left } else { right }));
+    let path = dir.path("blocks.jpg");
+    let mut bytes = Vec::new();
+    image::codecs::jpeg::JpegEncoder::new_with_quality(&mut bytes, 100).encode_image(&image).unwrap();
+    std::fs::write(&path, bytes).unwrap();
+    let texture = load_one(&path);
+    assert_eq!((texture.width(), texture.height()), (16, 8));
+    // Within 2 codes of the sRGB values, measured in the encoded domain (chroma subsampling and
+    // quantisation move flat blocks by a code or so).
+    let encoded = |linear: f32| {
+        let l = linear as f64;
+        (if l <= 0.0031308 { l * 12.92 } else { 1.055 * l.powf(1.0 / 2.4) - 0.055 }) * 255.0
+    };
+    for (uv, expected) in [(Vec2::new(0.25, 0.5), left), (Vec2::new(0.75, 0.5), right)] {
+        let got = texture.sample(uv);
+        for c in 0..3 {
+            let code = encoded(got[c]);
+            assert!(
+                (code - expected[c] as f64).abs() <= 2.0,
+                "{uv}: channel {c} decodes to code {code}, wrote {}",
+                expected[c]
+            );
+        }
+    }
+}
+
+#[test]
+fn alpha_is_kept_linear_and_sixteen_bit_pngs_decode_exactly() {
+    let dir = TempDir::new("textures-alpha");
+    let image = RgbaImage::from_fn(2, 2, |x, y| Rgba([255, 128, 0, [[0u8, 64], [191, 255]][y as usize][x as usize]]));
+    let path = dir.path("alpha.png");
+    image.save_with_format(&path, ImageFormat::Png).unwrap();
+    let texture = load_one(&path);
+    assert!(texture.has_alpha());
+    for (x, y, p) in image.enumerate_pixels() {
+        let uv = centre(x, y, 2, 2);
+        assert!((texture.sample_alpha(uv) - p.0[3] as f32 / 255.0).abs() < 1e-5, "alpha at ({x}, {y})");
+        assert!(close(texture.sample(uv), linear_rgb([255, 128, 0]), 1e-5));
+    }
+    let deep = image::ImageBuffer::<Rgb<u16>, Vec<u16>>::from_fn(2, 1, |x, _| Rgb([x as u16 * 40_000, 1000, 65_535]));
+    let path = dir.path("deep.png");
+    deep.save_with_format(&path, ImageFormat::Png).unwrap();
+    let texture = load_one(&path);
+    let expected = |c: u16| srgb_to_linear(c as f32 / 65535.0);
+    assert!(close(texture.texel(1, 0), Vec3::new(expected(40_000), expected(1000), 1.0), 1e-7));
+}
+
+#[test]
+fn unusable_files_cost_one_warning_each_and_no_texture() {
+    let dir = TempDir::new("textures-bad");
+    let good = dir.path("good.png");
+    test_image().save_with_format(&good, ImageFormat::Png).unwrap();
+    let missing = dir.path("missing.png");
+    let garbage = dir.write("garbage.jpg", b"this is not an image");
+    let truncated = {
+        let bytes = std::fs::read(&good).unwrap();
+        dir.write("truncated.png", &bytes[..bytes.len() / 2])
+    };
+    std::fs::create_dir(dir.path("folder.png")).unwrap();
+    let folder = dir.path("folder.png");
+    // Materials: none, good, missing, good again, garbage, truncated, a folder, missing again.
+    let map_kd: Vec<Option<PathBuf>> = vec![
+        None,
+        Some(good.clone()),
+        Some(missing.clone()),
+        Some(good.clone()),
+        Some(garbage.clone()),
+        Some(truncated),
+        Some(folder),
+        Some(missing.clone()),
+    ];
+    let (ids, set, warnings) = TextureSet::for_materials(map_kd.iter().map(|p| p.as_deref()));
+    assert_eq!(set.len(), 1, "the good file, decoded once");
+    let good_id = set.id_of(&good).unwrap();
+    assert_eq!(set.path(good_id), good);
+    assert_eq!(ids, vec![None, Some(good_id), None, Some(good_id), None, None, None, None]);
+    assert_eq!(warnings.len(), 4, "one per distinct unusable file: {warnings:#?}");
+    for (warning, name) in warnings.iter().zip(["missing.png", "garbage.jpg", "truncated.png", "folder.png"]) {
+        assert!(warning.contains(&format!("\"{}\"", dir.path(name).display())), "names the file, quoted: {warning}");
+        assert!(warning.contains("Kd is used instead"), "{warning}");
+        assert_eq!(warning.lines().count(), 1);
+    }
+    assert!(warnings[3].contains("not a regular file"), "{}", warnings[3]);
+}
+
+/// A PNG whose header claims 20000 × 20000 pixels is refused from the header, before decoding.
+#[test]
+fn absurd_image_sizes_are_refused_before_decoding() {
+    let dir = TempDir::new("textures-huge");
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    let chunk = |png: &mut Vec<u8>, kind: &[u8], data: &[u8]| {
+        png.extend((data.len() as u32).to_be_bytes());
+        let mut crc = flate2::Crc::new();
+        crc.update(kind);
+        crc.update(data);
+        png.extend(kind);
+        png.extend(data);
+        png.extend(crc.sum().to_be_bytes());
+    };
+    let mut header = Vec::new();
+    header.extend(20_000u32.to_be_bytes());
+    header.extend(20_000u32.to_be_bytes());
+    header.extend([8, 2, 0, 0, 0]); // 8-bit RGB
+    chunk(&mut png, b"IHDR", &header);
+    chunk(&mut png, b"IDAT", &[]);
+    chunk(&mut png, b"IEND", &[]);
+    let path = dir.write("huge.png", png);
+    let (set, warnings) = TextureSet::load(&[&path]);
+    assert!(set.is_empty());
+    assert_eq!(warnings.len(), 1);
+    assert!(warnings[0].contains("20000×20000") && warnings[0].contains(&MAX_TEXELS.to_string()), "{}", warnings[0]);
+}
+
+/// The staircase's textures, where `../shared` is present: all decode, each once.
+#[test]
+fn the_staircase_textures_decode() {
+    let Some(folder) = crate::common::shared_scene("staircase/textures") else { return };
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(&folder).unwrap().map(|e| e.unwrap().path()).collect();
+    paths.sort();
+    let (set, warnings) = TextureSet::load(&paths);
+    assert!(warnings.is_empty(), "{warnings:#?}");
+    assert_eq!(set.len(), paths.len());
+    println!("{} textures, {} MiB as linear f32", set.len(), set.memory_bytes() >> 20);
+}
