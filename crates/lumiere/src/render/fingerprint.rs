@@ -22,7 +22,10 @@ pub fn scene_fingerprint(scene: &Scene) -> u64 {
     mesh.material_ids.iter().for_each(|&m| h.write_u32(m));
     for m in &scene.materials {
         h.write(m.name.as_bytes());
-        h.write_f32s([m.kd, m.ks, m.ke].iter().flat_map(|v| v.to_array()).chain([m.ns, m.ni, m.dissolve]));
+        h.write_f32s([m.kd, m.ks, m.ke, m.tf].iter().flat_map(|v| v.to_array()).chain([m.ns, m.ni, m.dissolve]));
+        h.write_f32s([m.metallic, m.roughness].map(|v| v.unwrap_or(f32::NAN)));
+        h.write_u32(m.illum);
+        h.write(m.map_kd.as_deref().map_or(&b""[..], |p| p.as_os_str().as_encoded_bytes()));
     }
     h.finish()
 }
