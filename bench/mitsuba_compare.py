@@ -362,6 +362,7 @@ def main() -> int:
     command = shlex.join(["python3", *sys.argv])
     started = datetime.datetime.now().astimezone()
     load = os.getloadavg()[0]
+    commit = lumiere_commit()
 
     # --- Scene --------------------------------------------------------------------------------
     log(f"scene: {CORNELL / 'cornell.obj'} split by material into {out}")
@@ -478,7 +479,7 @@ def main() -> int:
     print()
     print(f"Command: `{command}`  ")
     print(f"Machine: {machine()}, 1-min load average {load:.2f} at start (timings assume an idle machine)  ")
-    print(f"Software: lumiere {lumiere_commit()}, Mitsuba {mi.__version__} ({VARIANT}, Dr.Jit {dr.__version__}, "
+    print(f"Software: lumiere {commit}, Mitsuba {mi.__version__} ({VARIANT}, Dr.Jit {dr.__version__}, "
           f"{Path(os.environ.get('DRJIT_LIBLLVM_PATH', 'LLVM')).name}), Python {platform.python_version()}  ")
     print(f"Date: {started.strftime('%Y-%m-%d %H:%M %Z')}; scene: gKit Cornell box, {width}x{height}, "
           f"path tracing max depth {args.max_depth}, {args.spp} spp, {args.threads} threads, "
