@@ -37,6 +37,14 @@ def cli():
     return run
 
 
+def optional(module: str, install: str):
+    """Imports an optional dependency, or skips the test without it; CI sets
+    LUMIERE_REQUIRE_EXTRAS=1 so that a missing one fails instead of skipping."""
+    if os.environ.get("LUMIERE_REQUIRE_EXTRAS") == "1":
+        return __import__(module)
+    return pytest.importorskip(module, reason=f"{module} is not installed: {install}")
+
+
 def read_pfm(path) -> np.ndarray:
     """A PFM file as lumiere writes it (little-endian RGB, rows bottom to top) as (h, w, 3), top row first."""
     data = pathlib.Path(path).read_bytes()
