@@ -1,6 +1,8 @@
 //! `render`: a whole render on a pool of `threads`, with the GIL released (see `watch.rs`), and the
 //! AOVs asked for; returns the image and AOVs as float32 bytes and the render's statistics.
 
+use std::sync::{Arc, Mutex};
+
 use lumiere::render::aov::{Aov, render_aovs};
 use lumiere::render::film::Film;
 use lumiere::render::{Hooks, RenderStats, render_progressive};
@@ -14,12 +16,21 @@ use crate::pixels::to_bytearray;
 use crate::scene::PyScene;
 use crate::watch::{self, Watch};
 
-/// A rayon pool of `threads` workers (0: one per core), as the CLI builds it.
-pub fn pool(threads: usize) -> PyResult<rayon::ThreadPool> {
-    rayon::ThreadPoolBuilder::new()
+/// A rayon pool of `threads` workers (0: one per core), as the CLI builds it, kept for the next
+/// render with that many: starting threads for every call would cost milliseconds a render.
+pub fn pool(threads: usize) -> PyResult<Arc<rayon::ThreadPool>> {
+    static POOLS: Mutex<Vec<(usize, Arc<rayon::ThreadPool>)>> = Mutex::new(Vec::new());
+    let mut pools = POOLS.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some((_, pool)) = pools.iter().find(|(n, _)| *n == threads) {
+        return Ok(pool.clone());
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
-        .map_err(|e| invalid(format!("cannot start {threads} threads: {e}")))
+        .map_err(|e| invalid(format!("cannot start {threads} threads: {e}")))?;
+    let pool = Arc::new(pool);
+    pools.push((threads, pool.clone()));
+    Ok(pool)
 }
 
 type Rendered<'py> = (Bound<'py, PyByteArray>, Vec<Bound<'py, PyByteArray>>, Bound<'py, PyDict>);
