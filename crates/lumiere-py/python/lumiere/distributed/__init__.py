@@ -100,7 +100,7 @@ def _render_range(
     scene: Scene, camera: Camera, option_args: Dict[str, Any], first: int, count: int, threads: int
 ) -> Dict[str, Any]:
     """The Ray task: passes ``first .. first + count``, each as ``(sample, float32 array, rays)``."""
-    start = time.perf_counter()
+    start, cpu = time.perf_counter(), time.process_time()
     options = _lumiere.NativeOptions(**option_args)
     passes = _lumiere.render_passes(scene._native, camera._native, options, first, count, threads)
     return {
@@ -110,6 +110,8 @@ def _render_range(
         "host": socket.gethostname(),
         "pid": os.getpid(),
         "seconds": time.perf_counter() - start,
+        # The worker process runs one task at a time: its CPU time is this task's.
+        "cpu_seconds": time.process_time() - cpu,
     }
 
 
@@ -133,7 +135,7 @@ def render_full(
     **technique_options: Any,
 ) -> RenderResult:
     """Like :func:`render`, returning the image and statistics (``tasks``: per task its first
-    pass, passes, worker seconds, host and pid; ``seconds``: the driver's wall time)."""
+    pass, passes, worker wall and CPU seconds, host and pid; ``seconds``: the driver's wall time)."""
     if not isinstance(scene, Scene):
         raise TypeError(f"scene must be a lumiere.Scene, got {type(scene).__name__}")
     option_args = dict(mode=str(mode), spp=spp, seed=seed, sampler=str(sampler), **technique_options)
@@ -170,7 +172,9 @@ def render_full(
                         "(is the same file at the same path on every node?)"
                     )
                 done[result["first"]] = result
-                records.append({k: result[k] for k in ("first", "seconds", "host", "pid")} | {"passes": len(result["passes"])})
+                records.append(
+                    {k: result[k] for k in ("first", "seconds", "cpu_seconds", "host", "pid")} | {"passes": len(result["passes"])}
+                )
             # Add whole tasks in pass order as soon as the next one is there.
             while film.samples in done:
                 for sample, values, rays in done.pop(film.samples)["passes"]:
