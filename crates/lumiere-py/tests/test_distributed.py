@@ -132,3 +132,10 @@ def test_a_clear_error_when_no_cluster_is_reachable(tmp_path):
     assert "no Ray cluster reachable at 127.0.0.1:9" in result.stderr
     assert time.perf_counter() - start < 60
     assert not (tmp_path / "x.pfm").exists()
+
+
+def test_bad_arguments_are_refused_before_connecting():
+    with pytest.raises(lumiere.LumiereError, match="spp must be at least 1"):
+        distributed.render(lumiere.builtin(), spp=0, address="127.0.0.1:9")
+    with pytest.raises(lumiere.LumiereError, match="tasks must be an integer of at least 1"):
+        distributed.render(lumiere.builtin(), spp=2, tasks=0, address="127.0.0.1:9")

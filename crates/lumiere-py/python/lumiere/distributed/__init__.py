@@ -138,6 +138,11 @@ def render_full(
     pass, passes, worker wall and CPU seconds, host and pid; ``seconds``: the driver's wall time)."""
     if not isinstance(scene, Scene):
         raise TypeError(f"scene must be a lumiere.Scene, got {type(scene).__name__}")
+    if not isinstance(spp, int) or spp < 1:
+        raise LumiereError(f"spp must be at least 1, got {spp!r} (a distributed render does a fixed number of passes)")
+    for name, value, least in (("tasks", tasks, 1), ("threads_per_task", threads_per_task, 1), ("max_retries", max_retries, 0)):
+        if value is not None and (not isinstance(value, int) or value < least):
+            raise LumiereError(f"{name} must be an integer of at least {least}, got {value!r}")
     option_args = dict(mode=str(mode), spp=spp, seed=seed, sampler=str(sampler), **technique_options)
     options = _options(mode, spp, seed, sampler, None, None, technique_options)
     camera = _camera(scene, camera, size)
