@@ -32,6 +32,20 @@ pub struct Film {
     pub discarded: u64,
 }
 
+/// The camera samples of one pass, as rendered: one value per pixel, row 0 at the top, before the
+/// film replaces invalid values (NaN, infinite, negative) by 0. Twelve bytes a pixel: the least a
+/// pass can be shipped as and still be added exactly (see [`Film::add_pass`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PassSamples {
+    /// The camera sample index of the pass (0 for the first).
+    pub sample: u32,
+    pub width: u32,
+    pub height: u32,
+    pub values: Vec<Vec3>,
+    /// Rays traced for this pass (camera rays and visibility queries).
+    pub rays: u64,
+}
+
 /// Rec. 709 luminance, the quantity whose noise the budgets measure.
 #[inline]
 pub fn luminance(c: Vec3) -> f64 {
@@ -79,6 +93,34 @@ impl Film {
         let pixels = self.pixel_count() as f64;
         let mean = mean_sum / pixels;
         Some(if mean > 0.0 { (variance_sum / pixels).sqrt() / mean } else { 0.0 })
+    }
+
+    /// Adds the samples of pass `pass.sample`, which must be the next one (`self.samples`): the
+    /// same additions, in the same order per pixel, as the progressive loop makes, so a film built
+    /// from passes rendered apart (other threads, processes or machines) holds the same bits as one
+    /// rendered in one go. Summing per-range films instead would not: floating-point addition is
+    /// not associative, so `(s + a) + b` and `s + (a + b)` may differ in the last bit.
+    pub fn add_pass(&mut self, pass: &PassSamples) -> Result<()> {
+        if (pass.width, pass.height) != (self.width, self.height) || pass.values.len() != self.pixel_count() {
+            return Err(Error::invalid(format!(
+                "pass {} is {}x{} with {} values but the film is {}x{}",
+                pass.sample,
+                pass.width,
+                pass.height,
+                pass.values.len(),
+                self.width,
+                self.height
+            )));
+        }
+        if pass.sample != self.samples {
+            return Err(Error::invalid(format!(
+                "pass {} cannot be added to a film of {} samples: passes are added in order",
+                pass.sample, self.samples
+            )));
+        }
+        self.add_tile(0, 0, self.width, &pass.values);
+        self.samples += 1;
+        Ok(())
     }
 
     /// Adds one sample per pixel, given row by row for the rectangle starting at `(x0, y0)`.

@@ -3,13 +3,30 @@
 //! index and the options, never on the thread that ran them, and passes are accumulated in order,
 //! so images are identical for any thread count and for any stopping point.
 
+/// Runs `$body` with `$integrator` bound to the integrator of `$technique`: one monomorphised render
+/// loop per technique, no dynamic dispatch per sample.
+macro_rules! with_integrator {
+    ($technique:expr, $integrator:ident => $body:expr) => {
+        match $technique {
+            $crate::integrators::Technique::Hits($integrator) => $body,
+            $crate::integrators::Technique::Materials($integrator) => $body,
+            $crate::integrators::Technique::Shadows($integrator) => $body,
+            $crate::integrators::Technique::Direct($integrator) => $body,
+            $crate::integrators::Technique::AmbientOcclusion($integrator) => $body,
+            $crate::integrators::Technique::Path($integrator) => $body,
+        }
+    };
+}
+
 pub mod aov;
 pub mod checkpoint;
 pub mod film;
 pub mod fingerprint;
 mod options;
+pub mod range;
 
 pub use options::RenderOptions;
+pub use range::render_pass_range;
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, RecvTimeoutError};
@@ -20,7 +37,7 @@ use rayon::prelude::*;
 
 use crate::accel::OriginBatch;
 use crate::error::{Error, Result};
-use crate::integrators::{Integrator, SampleContext, Technique};
+use crate::integrators::{Integrator, SampleContext};
 use crate::sampler::{SampleStream, Sampler};
 use crate::scene::camera::Camera;
 use crate::world::World;
@@ -115,15 +132,7 @@ pub fn render_progressive(
             film.width, film.height, camera.width, camera.height
         )));
     }
-    // One monomorphised render loop per technique: no dynamic dispatch per sample.
-    match &options.technique {
-        Technique::Hits(hits) => run_passes(hits, world, camera, options, film, stats, hooks),
-        Technique::Materials(materials) => run_passes(materials, world, camera, options, film, stats, hooks),
-        Technique::Shadows(shadows) => run_passes(shadows, world, camera, options, film, stats, hooks),
-        Technique::Direct(direct) => run_passes(direct, world, camera, options, film, stats, hooks),
-        Technique::AmbientOcclusion(ao) => run_passes(ao, world, camera, options, film, stats, hooks),
-        Technique::Path(path) => run_passes(path, world, camera, options, film, stats, hooks),
-    }
+    with_integrator!(&options.technique, integrator => run_passes(integrator, world, camera, options, film, stats, hooks))
 }
 
 fn run_passes<I: Integrator>(

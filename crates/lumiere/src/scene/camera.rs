@@ -10,7 +10,7 @@ use std::path::Path;
 use glam::{DMat4, DVec2, DVec3, DVec4, Vec3};
 
 use crate::error::{Error, Result};
-use crate::math::Ray;
+use crate::math::{Aabb, Ray};
 
 /// gKit's `Orbiter` state as stored in its text files (`c`, `p`, `r`, `s`, optional `f` lines).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -197,6 +197,23 @@ impl Camera {
             Projection::Pinhole { .. } => None,
         }
     }
+}
+
+/// The eye and target of a view from +z that frames all of `bounds` (its bounding sphere fills the
+/// vertical field of view `fov_degrees`): the camera front ends use when none is given. Refused,
+/// with the reason, for empty bounds or bounds too large to frame in `f32`.
+pub fn framing(bounds: &Aabb, fov_degrees: f32) -> std::result::Result<(Vec3, Vec3), &'static str> {
+    if bounds.is_empty() {
+        return Err("no vertices to frame");
+    }
+    let radius = 0.5 * bounds.extent().length();
+    let distance = radius / (0.5 * fov_degrees.to_radians()).sin();
+    let target = bounds.center();
+    let eye = target + Vec3::Z * distance.max(1e-6);
+    if !(eye.is_finite() && target.is_finite()) || eye == target {
+        return Err("its bounds are too large (or too far from the origin) to frame automatically");
+    }
+    Ok((eye, target))
 }
 
 /// Maps image position `(x, y)` at depths 0 and 1 back to world space (with the divide by w).

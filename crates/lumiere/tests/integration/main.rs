@@ -11,6 +11,7 @@ mod image_io;
 mod module_graph;
 mod obj_loading;
 mod path;
+mod range;
 mod sampling;
 mod seams;
 mod textures;

@@ -1,0 +1,56 @@
+"""lumiere: a CPU Monte Carlo ray tracer, from Python.
+
+    >>> import lumiere
+    >>> image = lumiere.render(lumiere.builtin(), spp=16, size=(256, 192))
+    >>> image.shape, image.dtype
+    ((192, 256, 3), dtype('float32'))
+
+:func:`load` and :func:`builtin` give a :class:`Scene` (or :meth:`Scene.from_arrays`), a
+:class:`Camera` frames it, :func:`render` returns a float32 numpy array (``height, width, 3``),
+:func:`denoise` cleans it with Intel Open Image Denoise (``pip install 'lumiere[denoise]'``), and
+:mod:`lumiere.distributed` splits a render across a Ray cluster with the same bytes
+(``pip install 'lumiere[ray]'``). Errors are :class:`LumiereError` (a ``ValueError``) or
+:class:`LumiereOSError` (an ``OSError``) with the CLI's messages. See docs/PYTHON.md.
+"""
+
+from ._denoise import denoise
+from ._lumiere import __version__
+from ._render import AOVS, MODES, TECHNIQUE_OPTIONS, RenderResult, render, render_full
+from ._scene import DEFAULT_SIZE, Camera, Scene, builtin, load
+from .errors import LumiereError, LumiereOSError
+
+__all__ = [
+    "AOVS",
+    "Camera",
+    "DEFAULT_SIZE",
+    "LumiereError",
+    "LumiereOSError",
+    "MODES",
+    "RenderResult",
+    "Scene",
+    "TECHNIQUE_OPTIONS",
+    "__version__",
+    "builtin",
+    "denoise",
+    "load",
+    "render",
+    "render_full",
+    "write_image",
+]
+
+
+def write_image(path: str, image: "object", exposure: float = 0.0, tonemap: str = "aces") -> None:
+    """Writes a ``(height, width, 3)`` float image as ``lumiere render -o`` does: ``.png``
+    (exposure, ``aces`` or ``clamp`` tone mapping, sRGB), ``.exr`` or ``.pfm`` (linear), atomically."""
+    import os
+
+    import numpy as np
+
+    array = np.ascontiguousarray(image, dtype=np.float32)
+    if array.ndim != 3 or array.shape[2] != 3:
+        raise LumiereError(f"image must have shape (height, width, 3), got {array.shape}")
+    height, width = array.shape[:2]
+    _write_image(os.fspath(path), width, height, array.tobytes(), exposure, tonemap)
+
+
+from ._lumiere import write_image as _write_image  # noqa: E402

@@ -1,0 +1,187 @@
+"""``lumiere.render``: a scene and a camera in, a float32 numpy image out (plus AOVs on request)."""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field
+from typing import Any, Callable, Dict, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _lumiere
+from ._scene import DEFAULT_SIZE, Camera, Scene
+from .errors import LumiereError
+
+__all__ = ["render", "render_full", "RenderResult", "MODES", "AOVS", "TECHNIQUE_OPTIONS"]
+
+#: What a pixel shows: path tracing (the default), or one of the lab's steps.
+MODES = ("path", "hits", "materials", "shadows", "direct", "ao")
+#: The arbitrary outputs :func:`render` can add: first-hit albedo, normal and depth.
+AOVS = ("albedo", "normal", "depth")
+#: Options of particular techniques, passed to :func:`render` as keywords.
+TECHNIQUE_OPTIONS = ("samples", "light_sampling", "ao_distance", "max_depth")
+
+Progress = Callable[[int, Optional[int]], Any]
+
+
+@dataclass(frozen=True)
+class RenderResult:
+    """Everything a render produced."""
+
+    #: Linear RGB radiance, float32, shape ``(height, width, 3)``, row 0 at the top.
+    image: np.ndarray
+    #: The AOVs asked for, by name: ``albedo`` and ``normal`` ``(height, width, 3)``,
+    #: ``depth`` ``(height, width)``.
+    aovs: Dict[str, np.ndarray] = field(default_factory=dict)
+    #: ``samples`` per pixel, ``rays``, ``seconds`` (rendering only), ``mrays_per_second``,
+    #: ``stop`` (why it stopped), ``discarded`` (invalid samples), ``threads``, ``relative_error``.
+    stats: Dict[str, Any] = field(default_factory=dict)
+
+
+def _array(buffer: bytearray, height: int, width: int) -> np.ndarray:
+    # A view of the bytearray the renderer filled: no copy, writable.
+    return np.frombuffer(buffer, dtype=np.float32).reshape(height, width, 3)
+
+
+def _options(
+    mode: str,
+    spp: Optional[int],
+    seed: int,
+    sampler: str,
+    time: Optional[float],
+    noise: Optional[float],
+    technique_options: Dict[str, Any],
+) -> "_lumiere.NativeOptions":
+    unknown = set(technique_options) - set(TECHNIQUE_OPTIONS)
+    if unknown:
+        raise TypeError(
+            f"render() got unexpected keyword arguments {sorted(unknown)}; technique options are {', '.join(TECHNIQUE_OPTIONS)}"
+        )
+    if not isinstance(seed, int) or not 0 <= seed < 2**64:
+        raise LumiereError(f"seed must be an integer in [0, 2**64), got {seed!r}")
+    if spp is not None and not isinstance(spp, (int, np.integer)):
+        raise LumiereError(f"spp must be an integer, got {spp!r}")
+    options = _lumiere.NativeOptions(
+        str(mode), None if spp is None else int(spp), seed, str(sampler), time=time, noise=noise, **technique_options
+    )
+    for message in options.ignored:
+        warnings.warn(message, stacklevel=3)
+    return options
+
+
+def _camera(scene: Scene, camera: Optional[Camera], size: Optional[Tuple[int, int]]) -> Camera:
+    if camera is not None:
+        if size is not None:
+            raise LumiereError("size applies only when camera is None: the camera has its own size")
+        if not isinstance(camera, Camera):
+            raise TypeError(f"camera must be a lumiere.Camera, got {type(camera).__name__}")
+        return camera
+    size = DEFAULT_SIZE if size is None else size
+    return Camera.builtin(size) if scene.is_builtin else Camera.framing(scene, size)
+
+
+def _threads(threads: int) -> int:
+    if not isinstance(threads, int) or threads < 0:
+        raise LumiereError(f"threads must be 0 (all cores) or more, got {threads!r}")
+    return threads
+
+
+def render_full(
+    scene: Scene,
+    camera: Optional[Camera] = None,
+    mode: str = "path",
+    spp: Optional[int] = 64,
+    seed: int = 0,
+    threads: int = 0,
+    *,
+    sampler: str = "independent",
+    size: Optional[Tuple[int, int]] = None,
+    aovs: Sequence[str] = (),
+    progress: Optional[Progress] = None,
+    time: Optional[float] = None,
+    noise: Optional[float] = None,
+    **technique_options: Any,
+) -> RenderResult:
+    """Like :func:`render`, returning the image, the AOVs and the statistics together."""
+    if not isinstance(scene, Scene):
+        raise TypeError(f"scene must be a lumiere.Scene (lumiere.load, lumiere.builtin), got {type(scene).__name__}")
+    options = _options(mode, spp, seed, sampler, time, noise, technique_options)
+    camera = _camera(scene, camera, size)
+    if isinstance(aovs, str):
+        aovs = (aovs,)
+    aovs = tuple(aovs)
+    image, buffers, stats = _lumiere.render(
+        scene._native, camera._native, options, _threads(threads), list(aovs), progress
+    )
+    height, width = camera.height, camera.width
+    outputs = {}
+    for name, buffer in zip(aovs, buffers):
+        array = _array(buffer, height, width)
+        # Depth is one number per pixel (the library repeats it in three channels).
+        outputs[name] = array[:, :, 0].copy() if name == "depth" else array
+    return RenderResult(_array(image, height, width), outputs, stats)
+
+
+def render(
+    scene: Scene,
+    camera: Optional[Camera] = None,
+    mode: str = "path",
+    spp: Optional[int] = 64,
+    seed: int = 0,
+    threads: int = 0,
+    *,
+    sampler: str = "independent",
+    size: Optional[Tuple[int, int]] = None,
+    aovs: Sequence[str] = (),
+    progress: Optional[Progress] = None,
+    time: Optional[float] = None,
+    noise: Optional[float] = None,
+    **technique_options: Any,
+) -> Union[np.ndarray, Dict[str, np.ndarray]]:
+    """Renders ``scene`` and returns linear RGB radiance as a float32 array ``(height, width, 3)``,
+    row 0 at the top: the values ``lumiere render -o image.pfm`` writes for the same options.
+
+    :param camera: a :class:`Camera`; None: the built-in scene's orbiter for
+        :func:`lumiere.builtin`, a view framing the scene otherwise (both ``size`` pixels,
+        default 1024x768).
+    :param mode: ``path`` (global illumination), or the lab's ``hits``, ``materials``,
+        ``shadows``, ``direct``, ``ao``.
+    :param spp: camera samples per pixel (1 = the lab's pixel centres, more are jittered). None
+        renders until ``time`` or ``noise`` stops it.
+    :param seed: same seed, same values, whatever ``threads``.
+    :param threads: worker threads, 0 = all cores.
+    :param sampler: ``independent`` or ``sobol``.
+    :param aovs: names among ``albedo``, ``normal``, ``depth``: the result is then a dict with
+        ``color`` and each AOV.
+    :param progress: called as ``progress(done, total)`` in pixel samples, from the calling
+        thread, every few milliseconds while samples are added (``total`` is None with a budget).
+        An exception it raises stops the render and propagates.
+    :param time: stop after the pass that crosses this many seconds.
+    :param noise: stop once the estimated relative error is below this.
+    :param technique_options: ``samples`` (direct, ao: points per light or directions; default
+        16), ``light_sampling`` (direct: ``per-light`` or ``power``), ``ao_distance`` (ao),
+        ``max_depth`` (path: segments from the camera, default 8, 0 = no limit).
+
+    The GIL is released while rendering; Ctrl-C stops the render within milliseconds and raises
+    :class:`KeyboardInterrupt`.
+
+    :raises LumiereError: a bad option (with the CLI's message); a :class:`LumiereOSError` for files.
+    """
+    result = render_full(
+        scene,
+        camera,
+        mode,
+        spp,
+        seed,
+        threads,
+        sampler=sampler,
+        size=size,
+        aovs=aovs,
+        progress=progress,
+        time=time,
+        noise=noise,
+        **technique_options,
+    )
+    if not result.aovs and not aovs:
+        return result.image
+    return {"color": result.image, **result.aovs}

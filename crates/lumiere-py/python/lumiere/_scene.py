@@ -1,0 +1,300 @@
+"""Scenes and cameras: thin wrappers over the native objects that remember how they were made, so
+that they pickle (Ray ships them to workers, which rebuild them) and print helpfully."""
+
+from __future__ import annotations
+
+import os
+import uuid
+from collections import OrderedDict
+from typing import Any, Dict, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _lumiere
+from .errors import LumiereError, LumiereOSError
+
+__all__ = ["Scene", "Camera", "load", "builtin", "DEFAULT_SIZE"]
+
+PathLike = Union[str, "os.PathLike[str]"]
+Vector = Sequence[float]
+
+#: The image size of the lab (and of ``lumiere render``): 1024x768, as (width, height).
+DEFAULT_SIZE: Tuple[int, int] = (1024, 768)
+
+
+def _emission_list(emission: Optional[Mapping[str, Vector]]) -> list:
+    if emission is None:
+        return []
+    if not isinstance(emission, Mapping):
+        raise LumiereError("emission must be a dict {material name: (r, g, b)}")
+    return [(str(name), _vector(value, f"emission[{name!r}]")) for name, value in emission.items()]
+
+
+def _vector(value: Any, what: str) -> Tuple[float, float, float]:
+    try:
+        x, y, z = (float(v) for v in value)
+    except (TypeError, ValueError):
+        raise LumiereError(f"{what} must be three numbers, got {value!r}") from None
+    return (x, y, z)
+
+
+def _size(size: Any) -> Tuple[int, int]:
+    try:
+        width, height = (int(v) for v in size)
+    except (TypeError, ValueError):
+        raise LumiereError(f"size must be (width, height), got {size!r}") from None
+    if width <= 0 or height <= 0:
+        raise LumiereError(f"image size {width}x{height} has no pixels")
+    return (width, height)
+
+
+class Scene:
+    """A scene ready to render: triangles, materials, and the BVH and lights built from them.
+
+    Make one with :func:`lumiere.load` (an OBJ file), :func:`lumiere.builtin` (gKit's Cornell box)
+    or :meth:`Scene.from_arrays` (numpy arrays). Scenes pickle by recipe: the unpickling process
+    loads the file again (it must see the same file) or rebuilds the arrays.
+    """
+
+    __slots__ = ("_native", "_recipe")
+
+    def __init__(self, native: "_lumiere.NativeScene", recipe: tuple) -> None:
+        self._native = native
+        self._recipe = recipe
+
+    @classmethod
+    def from_arrays(
+        cls,
+        vertices: Any,
+        triangles: Any,
+        materials: Optional[Sequence[Union[str, Mapping[str, Any]]]] = None,
+        material_ids: Any = None,
+        normals: Any = None,
+        name: str = "arrays",
+    ) -> "Scene":
+        """A scene from numpy arrays.
+
+        :param vertices: positions, shape ``(N, 3)``, any float type (stored as float32).
+        :param triangles: vertex indices, shape ``(M, 3)``, integers in ``[0, N)``.
+        :param materials: a list of materials, each a name or a dict with ``name``, ``kd``
+            (diffuse colour, default 0.8 grey) and ``ke`` (emitted radiance: a light). Default: one
+            grey material.
+        :param material_ids: the material of each triangle, shape ``(M,)``; default all 0.
+        :param normals: optional per-vertex shading normals, shape ``(N, 3)``.
+        """
+        vertices = np.ascontiguousarray(vertices, dtype=np.float32)
+        if vertices.ndim != 2 or vertices.shape[1] != 3:
+            raise LumiereError(f"vertices must have shape (N, 3), got {vertices.shape}")
+        triangles = np.asarray(triangles)
+        if triangles.ndim != 2 or triangles.shape[1] != 3 or not np.issubdtype(triangles.dtype, np.integer):
+            raise LumiereError(f"triangles must be integers of shape (M, 3), got {triangles.dtype} {triangles.shape}")
+        if triangles.size and (triangles.min() < 0 or triangles.max() >= len(vertices)):
+            raise LumiereError(f"triangles index vertices 0..{len(vertices) - 1}, found {triangles.min()}..{triangles.max()}")
+        triangles = np.ascontiguousarray(triangles, dtype=np.uint32)
+        specs = []
+        for index, material in enumerate(materials if materials is not None else ["default"]):
+            if isinstance(material, str):
+                material = {"name": material}
+            if not isinstance(material, Mapping) or "name" not in material:
+                raise LumiereError(f"materials[{index}] must be a name or a dict with a 'name', got {material!r}")
+            unknown = set(material) - {"name", "kd", "ke"}
+            if unknown:
+                raise LumiereError(f"materials[{index}]: unknown keys {sorted(unknown)} (known: name, kd, ke)")
+            kd = _vector(material.get("kd", (0.8, 0.8, 0.8)), f"materials[{index}]['kd']")
+            ke = _vector(material.get("ke", (0.0, 0.0, 0.0)), f"materials[{index}]['ke']")
+            specs.append((str(material["name"]), kd, ke))
+        if material_ids is None:
+            ids = np.zeros(len(triangles), dtype=np.uint32)
+        else:
+            ids = np.asarray(material_ids)
+            if ids.shape != (len(triangles),) or not np.issubdtype(ids.dtype, np.integer):
+                raise LumiereError(f"material_ids must be {len(triangles)} integers, got {ids.dtype} {ids.shape}")
+            if ids.size and (ids.min() < 0 or ids.max() >= len(specs)):
+                raise LumiereError(f"material_ids index materials 0..{len(specs) - 1}, found {ids.min()}..{ids.max()}")
+            ids = np.ascontiguousarray(ids, dtype=np.uint32)
+        if normals is not None:
+            normals = np.ascontiguousarray(normals, dtype=np.float32)
+            if normals.shape != vertices.shape:
+                raise LumiereError(f"normals must have the shape of vertices {vertices.shape}, got {normals.shape}")
+        native = _lumiere.NativeScene.from_arrays(
+            name,
+            vertices.tobytes(),
+            triangles.tobytes(),
+            ids.tobytes(),
+            specs,
+            None if normals is None else normals.tobytes(),
+        )
+        recipe = ("arrays", vertices, triangles, specs, ids, normals, name, uuid.uuid4().hex)
+        return cls(native, recipe)
+
+    def info(self) -> Dict[str, Any]:
+        """What ``lumiere info`` prints: ``name``, ``triangles``, ``vertices``, ``materials`` (by
+        name: ``triangles``, ``kd``, ``ke``, ``texture``, ``light``), ``lights`` (``triangles``,
+        ``area``, ``power``), ``bounds`` (``(min, max)`` or None), ``warnings``, load and build
+        seconds."""
+        return self._native.info()
+
+    @property
+    def name(self) -> str:
+        return self._native.name
+
+    @property
+    def warnings(self) -> list:
+        """Non-fatal problems met while loading (a missing MTL file, an unknown material)."""
+        return self._native.warnings
+
+    @property
+    def fingerprint(self) -> int:
+        """A hash of the geometry and materials (emission included), as checkpoints store it."""
+        return self._native.fingerprint
+
+    @property
+    def is_builtin(self) -> bool:
+        return self._native.builtin
+
+    def __reduce__(self) -> tuple:
+        return (_rebuild_scene, (self._recipe,))
+
+    def __repr__(self) -> str:
+        return repr(self._native)
+
+
+#: Scenes rebuilt from pickles, by recipe: a Ray worker that runs many tasks of one render loads
+#: its scene (and builds its BVH) once. A few are kept, the least recently used dropped.
+_SCENES: "OrderedDict[tuple, _lumiere.NativeScene]" = OrderedDict()
+_SCENES_KEPT = 4
+
+
+def _rebuild_scene(recipe: tuple) -> Scene:
+    kind = recipe[0]
+    if kind == "load":
+        key: tuple = (kind, recipe[1], tuple(recipe[2]))
+    elif kind == "arrays":
+        key = (kind, recipe[-1])
+    else:
+        raise LumiereError(f"unknown scene recipe {kind!r}")
+    native = _SCENES.get(key)
+    if native is None:
+        if kind == "load":
+            native = _lumiere.NativeScene.load(recipe[1], list(recipe[2]))
+        else:
+            _, vertices, triangles, specs, ids, normals, name, _ = recipe
+            native = _lumiere.NativeScene.from_arrays(
+                name, vertices.tobytes(), triangles.tobytes(), ids.tobytes(), specs, None if normals is None else normals.tobytes()
+            )
+        _SCENES[key] = native
+        while len(_SCENES) > _SCENES_KEPT:
+            _SCENES.popitem(last=False)
+    _SCENES.move_to_end(key)
+    return Scene(native, recipe)
+
+
+def load(path: PathLike, emission: Optional[Mapping[str, Vector]] = None) -> Scene:
+    """Loads a Wavefront OBJ scene (``.obj`` or ``.obj.gz``, with its MTL files and textures).
+
+    :param emission: sets the emitted radiance of materials by name, as ``--emission`` does:
+        ``{"Light": (17, 12, 4)}``; a name the scene lacks is an error.
+    :raises LumiereOSError: the file cannot be read.
+    :raises LumiereError: the file is malformed (the message names the file and line).
+    """
+    path = os.path.abspath(os.fspath(path))
+    emission = _emission_list(emission)
+    return Scene(_lumiere.NativeScene.load(path, emission), ("load", path, emission))
+
+
+def builtin(emission: Optional[Mapping[str, Vector]] = None) -> Scene:
+    """gKit's Cornell box, embedded in lumiere (what ``lumiere render`` renders without a scene).
+    With ``camera=None``, :func:`lumiere.render` uses its orbiter camera."""
+    emission = _emission_list(emission)
+    return Scene(_lumiere.NativeScene.load(None, emission), ("load", None, emission))
+
+
+class Camera:
+    """A camera and the image size it renders, ``size = (width, height)`` in pixels.
+
+    Pickles by recipe (an orbiter keeps the file's text, so workers need no copy of it).
+    """
+
+    __slots__ = ("_native", "_recipe")
+
+    def __init__(self, native: "_lumiere.NativeCamera", recipe: tuple) -> None:
+        self._native = native
+        self._recipe = recipe
+
+    @classmethod
+    def look_at(
+        cls,
+        eye: Vector,
+        target: Vector,
+        up: Vector = (0.0, 1.0, 0.0),
+        fov: float = 45.0,
+        size: Tuple[int, int] = DEFAULT_SIZE,
+    ) -> "Camera":
+        """A pinhole at ``eye`` looking at ``target``, ``fov`` the vertical field of view in degrees
+        (``--eye/--target/--up/--fov`` of the CLI)."""
+        args = (_vector(eye, "eye"), _vector(target, "target"), _vector(up, "up"), float(fov), *_size(size))
+        return cls(_lumiere.NativeCamera.look_at(*args), ("look_at", args))
+
+    @classmethod
+    def orbiter(cls, path: PathLike, size: Tuple[int, int] = DEFAULT_SIZE) -> "Camera":
+        """gKit's orbiter camera from an orbiter file (``--orbiter``)."""
+        path = os.fspath(path)
+        try:
+            with open(path, "rb") as file:
+                text = file.read()
+        except OSError as e:
+            error = LumiereOSError(f"{path}: {e.strerror} (os error {e.errno})")
+            error.errno, error.filename = e.errno, path
+            raise error from None
+        args = (text, path, *_size(size))
+        return cls(_lumiere.NativeCamera.orbiter(*args), ("orbiter", args))
+
+    @classmethod
+    def builtin(cls, size: Tuple[int, int] = DEFAULT_SIZE) -> "Camera":
+        """The built-in scene's camera: gKit's 2022 orbiter of the Cornell box."""
+        args = _size(size)
+        return cls(_lumiere.NativeCamera.builtin(*args), ("builtin", args))
+
+    @classmethod
+    def framing(
+        cls, scene: Scene, size: Tuple[int, int] = DEFAULT_SIZE, fov: float = 45.0, up: Vector = (0.0, 1.0, 0.0)
+    ) -> "Camera":
+        """A look-at view from +z that frames the whole scene: the CLI's camera for a scene file
+        given without one."""
+        eye, target = _lumiere.NativeCamera.framing(scene._native, float(fov))
+        return cls.look_at(eye, target, up, fov, size)
+
+    @property
+    def size(self) -> Tuple[int, int]:
+        """``(width, height)``; the rendered array has shape ``(height, width, 3)``."""
+        return (self._native.width, self._native.height)
+
+    @property
+    def width(self) -> int:
+        return self._native.width
+
+    @property
+    def height(self) -> int:
+        return self._native.height
+
+    def __reduce__(self) -> tuple:
+        return (_rebuild_camera, (self._recipe,))
+
+    def __repr__(self) -> str:
+        kind, args = self._recipe
+        if kind == "orbiter":
+            return f"Camera.orbiter({args[1]!r}, size={self.size})"
+        if kind == "builtin":
+            return f"Camera.builtin(size={self.size})"
+        eye, target, up, fov = args[:4]
+        return f"Camera.look_at(eye={eye}, target={target}, up={up}, fov={fov}, size={self.size})"
+
+
+def _rebuild_camera(recipe: tuple) -> Camera:
+    kind, args = recipe
+    factory = {
+        "look_at": _lumiere.NativeCamera.look_at,
+        "orbiter": _lumiere.NativeCamera.orbiter,
+        "builtin": _lumiere.NativeCamera.builtin,
+    }[kind]
+    return Camera(factory(*args), recipe)

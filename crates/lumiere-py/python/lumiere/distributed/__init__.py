@@ -1,0 +1,266 @@
+"""Distributed rendering on Ray, with the bytes of a single-process render.
+
+A render of ``spp`` samples per pixel is ``spp`` passes of one camera sample per pixel. Tasks
+render ranges of passes anywhere in the cluster and return each pass's raw samples (float32 RGB
+per pixel); the driver adds them to its film strictly in pass order, pass after pass, which are
+the very floating-point additions :func:`lumiere.render` makes. So the image (and a checkpoint,
+which ``lumiere render --resume`` accepts) has the same bytes whatever the number of workers, the
+order tasks finish in, or a worker killed and its task retried. (Summing per-task films instead
+would not: floating-point addition is not associative.)
+
+    >>> import lumiere, lumiere.distributed
+    >>> image = lumiere.distributed.render(lumiere.builtin(), spp=64, address="auto")
+
+Needs Ray: ``pip install 'lumiere[ray]'``. See docs/DISTRIBUTED.md for measurements.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import socket
+import time
+from typing import Any, Dict, List, Optional, Sequence, Tuple
+
+import numpy as np
+
+from .. import _lumiere
+from .._render import Progress, RenderResult, _array, _camera, _options
+from .._scene import Camera, Scene
+from ..errors import LumiereError
+
+__all__ = ["ClusterUnreachable", "connect", "render", "render_full", "split_passes"]
+
+
+class ClusterUnreachable(ConnectionError):
+    """No Ray cluster answers at the address given."""
+
+
+def _ray() -> Any:
+    try:
+        import ray
+    except ImportError as e:
+        raise ImportError("lumiere.distributed needs Ray: pip install 'lumiere[ray]' (or pip install ray)") from e
+    return ray
+
+
+def _check_reachable(address: str, timeout: float) -> None:
+    """Fails fast, with a clear message, where Ray itself would retry for a minute."""
+    if address in ("auto", "local") or "://" in address:
+        return
+    host, _, port = address.rpartition(":")
+    try:
+        with socket.create_connection((host or "127.0.0.1", int(port)), timeout=timeout):
+            pass
+    except ValueError:
+        raise ClusterUnreachable(f"invalid Ray address {address!r}: expected host:port or 'auto'") from None
+    except OSError as e:
+        raise ClusterUnreachable(
+            f"no Ray cluster reachable at {address}: {e.strerror or e}; start one with `ray start --head` "
+            "or pass address=None to start a local one"
+        ) from None
+
+
+def connect(address: Optional[str] = "auto", timeout: float = 5.0) -> Any:
+    """Connects this process to a Ray cluster (once; later calls reuse the connection) and returns
+    the ``ray`` module.
+
+    :param address: ``host:port`` of the head's GCS, ``auto`` (``RAY_ADDRESS`` or the cluster
+        ``ray start`` last started on this machine), or None to start a local Ray instance.
+    :raises ClusterUnreachable: nothing answers at ``address`` (within ``timeout`` seconds).
+    """
+    ray = _ray()
+    if ray.is_initialized():
+        return ray
+    if address is None:
+        ray.init(include_dashboard=False, logging_level="warning")
+        return ray
+    _check_reachable(address, timeout)
+    try:
+        ray.init(address=address, logging_level="warning")
+    except ConnectionError as e:
+        raise ClusterUnreachable(f"no Ray cluster reachable at {address!r}: {e}") from None
+    return ray
+
+
+def split_passes(first: int, end: int, tasks: int) -> List[Tuple[int, int]]:
+    """Passes ``first .. end`` as at most ``tasks`` contiguous ``(first, count)`` ranges of sizes
+    differing by at most one."""
+    total = end - first
+    tasks = max(1, min(tasks, total))
+    ranges = []
+    for index in range(tasks):
+        start = first + index * total // tasks
+        stop = first + (index + 1) * total // tasks
+        ranges.append((start, stop - start))
+    return [r for r in ranges if r[1] > 0]
+
+
+def _render_range(
+    scene: Scene, camera: Camera, option_args: Dict[str, Any], first: int, count: int, threads: int
+) -> Dict[str, Any]:
+    """The Ray task: passes ``first .. first + count``, each as ``(sample, float32 array, rays)``."""
+    start, cpu = time.perf_counter(), time.process_time()
+    options = _lumiere.NativeOptions(**option_args)
+    passes = _lumiere.render_passes(scene._native, camera._native, options, first, count, threads)
+    return {
+        "first": first,
+        "passes": [(sample, np.frombuffer(values, dtype=np.float32), rays) for sample, values, rays in passes],
+        "fingerprint": scene.fingerprint,
+        "host": socket.gethostname(),
+        "pid": os.getpid(),
+        "seconds": time.perf_counter() - start,
+        # The worker process runs one task at a time: its CPU time is this task's.
+        "cpu_seconds": time.process_time() - cpu,
+    }
+
+
+def render_full(
+    scene: Scene,
+    camera: Optional[Camera] = None,
+    mode: str = "path",
+    spp: int = 64,
+    seed: int = 0,
+    *,
+    sampler: str = "independent",
+    size: Optional[Tuple[int, int]] = None,
+    address: Optional[str] = "auto",
+    tasks: Optional[int] = None,
+    threads_per_task: int = 1,
+    max_retries: int = 3,
+    checkpoint: Optional[str] = None,
+    checkpoint_every: float = 60.0,
+    resume: bool = False,
+    progress: Optional[Progress] = None,
+    **technique_options: Any,
+) -> RenderResult:
+    """Like :func:`render`, returning the image and statistics (``tasks``: per task its first
+    pass, passes, worker wall and CPU seconds, host and pid; ``seconds``: the driver's wall time)."""
+    if not isinstance(scene, Scene):
+        raise TypeError(f"scene must be a lumiere.Scene, got {type(scene).__name__}")
+    if not isinstance(spp, int) or spp < 1:
+        raise LumiereError(f"spp must be at least 1, got {spp!r} (a distributed render does a fixed number of passes)")
+    for name, value, least in (("tasks", tasks, 1), ("threads_per_task", threads_per_task, 1), ("max_retries", max_retries, 0)):
+        if value is not None and (not isinstance(value, int) or value < least):
+            raise LumiereError(f"{name} must be an integer of at least {least}, got {value!r}")
+    option_args = dict(mode=str(mode), spp=spp, seed=seed, sampler=str(sampler), **technique_options)
+    options = _options(mode, spp, seed, sampler, None, None, technique_options)
+    camera = _camera(scene, camera, size)
+    width, height = camera.size
+    if resume and checkpoint is not None and os.path.exists(checkpoint):
+        film = _lumiere.NativeFilm.load_checkpoint(checkpoint, scene._native, camera._native, options)
+    else:
+        film = _lumiere.NativeFilm(width, height)
+    if film.samples > spp:
+        raise LumiereError(f"{checkpoint}: the checkpoint has {film.samples} samples per pixel, more than spp={spp}")
+    ray = connect(address)
+    start = time.perf_counter()
+    cpus = max(1, int(ray.cluster_resources().get("CPU", 1) // max(1, threads_per_task)))
+    # A few tasks per CPU: the last ones to finish keep every worker busy till the end.
+    ranges = split_passes(film.samples, spp, tasks or 4 * cpus)
+    task = ray.remote(_render_range).options(num_cpus=threads_per_task, max_retries=max_retries)
+    scene_ref, camera_ref = ray.put(scene), ray.put(camera)
+    pending = {task.remote(scene_ref, camera_ref, option_args, first, count, threads_per_task): (first, count) for first, count in ranges}
+    done: Dict[int, Dict[str, Any]] = {}
+    records: List[Dict[str, Any]] = []
+    pixels = width * height
+    last_checkpoint = time.monotonic()
+    try:
+        while pending:
+            ready, _ = ray.wait(list(pending), num_returns=1, timeout=0.5)
+            for ref in ready:
+                pending.pop(ref)
+                result = ray.get(ref)
+                if result["fingerprint"] != scene.fingerprint:
+                    raise LumiereError(
+                        f"{scene.name}: the worker on {result['host']} loaded a different scene "
+                        "(is the same file at the same path on every node?)"
+                    )
+                done[result["first"]] = result
+                records.append(
+                    {k: result[k] for k in ("first", "seconds", "cpu_seconds", "host", "pid")} | {"passes": len(result["passes"])}
+                )
+            # Add whole tasks in pass order as soon as the next one is there.
+            while film.samples in done:
+                for sample, values, rays in done.pop(film.samples)["passes"]:
+                    film.add_pass(sample, values.tobytes(), rays)
+            if progress is not None:
+                progress(film.samples * pixels, spp * pixels)
+            if checkpoint is not None and time.monotonic() - last_checkpoint >= checkpoint_every:
+                film.save_checkpoint(checkpoint, scene._native, camera._native, options)
+                last_checkpoint = time.monotonic()
+    except BaseException:
+        for ref in pending:
+            ray.cancel(ref, force=True)
+        if checkpoint is not None and film.samples > 0:
+            film.save_checkpoint(checkpoint, scene._native, camera._native, options)
+        raise
+    seconds = time.perf_counter() - start
+    film.seconds = film.seconds + seconds
+    if checkpoint is not None:
+        film.save_checkpoint(checkpoint, scene._native, camera._native, options)
+    stats = {
+        "samples": film.samples,
+        "rays": film.rays,
+        "seconds": seconds,
+        "discarded": film.discarded,
+        "relative_error": film.relative_error(),
+        "tasks": sorted(records, key=lambda r: r["first"]),
+        "cpus": cpus,
+    }
+    return RenderResult(_array(film.image(), height, width), {}, stats)
+
+
+def render(
+    scene: Scene,
+    camera: Optional[Camera] = None,
+    mode: str = "path",
+    spp: int = 64,
+    seed: int = 0,
+    *,
+    sampler: str = "independent",
+    size: Optional[Tuple[int, int]] = None,
+    address: Optional[str] = "auto",
+    tasks: Optional[int] = None,
+    threads_per_task: int = 1,
+    max_retries: int = 3,
+    checkpoint: Optional[str] = None,
+    checkpoint_every: float = 60.0,
+    resume: bool = False,
+    progress: Optional[Progress] = None,
+    **technique_options: Any,
+) -> np.ndarray:
+    """Renders on a Ray cluster; returns the array :func:`lumiere.render` returns for the same
+    scene, camera and options, bit for bit.
+
+    :param address: the cluster (see :func:`connect`); None starts a local Ray instance.
+    :param tasks: how many tasks to split the passes into (default 4 per CPU of the cluster).
+    :param threads_per_task: CPUs (and threads) each task takes.
+    :param max_retries: times Ray reruns a task whose worker died (the bytes do not change).
+    :param checkpoint: a file where the merged film is saved every ``checkpoint_every`` seconds,
+        on interruption and at the end, in the CLI's format (``lumiere render --resume`` reads it).
+    :param resume: continue from ``checkpoint`` when it exists (same scene and options; more
+        ``spp`` is fine).
+    :param progress: ``progress(done, total)`` in pixel samples, as passes are merged.
+
+    Budgets (``time``, ``noise``) are not offered: a distributed render does a fixed number of
+    passes. The other parameters are :func:`lumiere.render`'s.
+    """
+    return render_full(
+        scene,
+        camera,
+        mode,
+        spp,
+        seed,
+        sampler=sampler,
+        size=size,
+        address=address,
+        tasks=tasks,
+        threads_per_task=threads_per_task,
+        max_retries=max_retries,
+        checkpoint=checkpoint,
+        checkpoint_every=checkpoint_every,
+        resume=resume,
+        progress=progress,
+        **technique_options,
+    ).image

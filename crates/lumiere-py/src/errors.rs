@@ -1,0 +1,41 @@
+//! Library errors as Python exceptions carrying the CLI's one-line messages: files that cannot be
+//! read or written raise `lumiere.LumiereOSError` (an `OSError`, with `errno` and `filename`),
+//! everything else `lumiere.LumiereError` (a `ValueError`). The classes live in
+//! `lumiere/errors.py`, where Python can give them both bases.
+
+use pyo3::prelude::*;
+
+/// The Python exception for a library error.
+pub fn to_py(error: lumiere::Error) -> PyErr {
+    Python::attach(|py| build(py, &error).unwrap_or_else(|e| e))
+}
+
+fn build(py: Python<'_>, error: &lumiere::Error) -> PyResult<PyErr> {
+    let errors = py.import("lumiere.errors")?;
+    let instance = match error {
+        lumiere::Error::Io { path, source } => {
+            let instance = errors.getattr("LumiereOSError")?.call1((error.to_string(),))?;
+            instance.setattr("errno", source.raw_os_error())?;
+            instance.setattr("filename", path.display().to_string())?;
+            instance
+        }
+        _ => errors.getattr("LumiereError")?.call1((error.to_string(),))?,
+    };
+    Ok(PyErr::from_value(instance))
+}
+
+/// `LumiereError(message)`, for refusals the bindings make themselves.
+pub fn invalid(message: impl Into<String>) -> PyErr {
+    to_py(lumiere::Error::invalid(message))
+}
+
+/// Converts a library result.
+pub trait OrPyErr<T> {
+    fn or_py(self) -> PyResult<T>;
+}
+
+impl<T> OrPyErr<T> for lumiere::Result<T> {
+    fn or_py(self) -> PyResult<T> {
+        self.map_err(to_py)
+    }
+}

@@ -1,0 +1,160 @@
+//! What `lumiere.distributed` needs from the library: a worker renders a range of passes and ships
+//! each pass's raw samples; the driver adds them to a film strictly in pass order (the additions
+//! the progressive loop makes, so the bytes match a local render) and saves checkpoints in the
+//! CLI's format, which `lumiere render --resume` accepts too.
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use lumiere::render::RenderStats;
+use lumiere::render::checkpoint::{Checkpoint, differing_options};
+use lumiere::render::film::{Film, PassSamples};
+use lumiere::render::fingerprint::options_description;
+use lumiere::render::render_pass_range;
+use lumiere::util::hash::hash_bytes;
+use pyo3::prelude::*;
+use pyo3::types::PyByteArray;
+
+use crate::camera::PyCamera;
+use crate::errors::{OrPyErr, invalid};
+use crate::options::PyOptions;
+use crate::pixels::{from_bytes, to_bytearray};
+use crate::render::pool;
+use crate::scene::PyScene;
+use crate::watch;
+
+/// One rendered pass: its sample index, its values (float32 RGB per pixel) and its rays.
+type Pass<'py> = (u32, Bound<'py, PyByteArray>, u64);
+
+/// Renders passes `first .. first + count` on `threads` threads with the GIL released.
+#[pyfunction]
+#[pyo3(signature = (scene, camera, options, first, count, threads, progress=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn render_passes<'py>(
+    py: Python<'py>,
+    scene: &PyScene,
+    camera: &PyCamera,
+    options: &PyOptions,
+    first: u32,
+    count: u32,
+    threads: usize,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<Vec<Pass<'py>>> {
+    let (world, camera, options) = (&*scene.world, &camera.camera, &options.options);
+    let pool = pool(threads)?;
+    let total = u64::from(camera.width) * u64::from(camera.height) * u64::from(count);
+    let passes = watch::run(py, Some(total), progress.as_ref(), |watch| {
+        let count_samples = |n| {
+            watch.done.fetch_add(n, std::sync::atomic::Ordering::Relaxed);
+        };
+        pool.install(|| render_pass_range(world, camera, options, first, count, &count_samples, &watch.cancel))
+    })?;
+    passes.iter().map(|p| Ok((p.sample, to_bytearray(py, &p.values)?, p.rays))).collect()
+}
+
+/// A film that passes are added to in order, with the render's totals.
+#[pyclass(module = "lumiere._lumiere", name = "NativeFilm")]
+pub struct PyFilm {
+    film: Film,
+    stats: RenderStats,
+}
+
+#[pymethods]
+impl PyFilm {
+    #[new]
+    fn new(width: u32, height: u32) -> PyResult<Self> {
+        Ok(PyFilm { film: Film::new(width, height).or_py()?, stats: RenderStats::default() })
+    }
+
+    /// Adds pass `sample`, which must be the next one.
+    fn add_pass(&mut self, sample: u32, values: &[u8], rays: u64) -> PyResult<()> {
+        let values = from_bytes(values, self.film.pixel_count(), &format!("pass {sample}"))?;
+        let pass = PassSamples { sample, width: self.film.width, height: self.film.height, values, rays };
+        self.film.add_pass(&pass).or_py()?;
+        self.stats.rays += rays;
+        Ok(())
+    }
+
+    /// Camera samples per pixel so far (the next pass to add).
+    #[getter]
+    fn samples(&self) -> u32 {
+        self.film.samples
+    }
+
+    #[getter]
+    fn rays(&self) -> u64 {
+        self.stats.rays
+    }
+
+    #[getter]
+    fn discarded(&self) -> u64 {
+        self.film.discarded
+    }
+
+    /// Rendering seconds (summed over the sessions of a resumed render); the driver sets it.
+    #[getter]
+    fn get_seconds(&self) -> f64 {
+        self.stats.elapsed.as_secs_f64()
+    }
+
+    #[setter]
+    fn set_seconds(&mut self, seconds: f64) -> PyResult<()> {
+        self.stats.elapsed = Duration::try_from_secs_f64(seconds).map_err(|_| invalid("seconds must be >= 0"))?;
+        Ok(())
+    }
+
+    fn relative_error(&self) -> Option<f64> {
+        self.film.relative_error()
+    }
+
+    /// The current estimate as float32 RGB bytes, row 0 at the top.
+    fn image<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyByteArray>> {
+        to_bytearray(py, &self.film.image().pixels)
+    }
+
+    /// Saves the film as a checkpoint of the render of `scene`, `camera` and `options`: the
+    /// CLI's format, so `lumiere render --resume` continues it.
+    fn save_checkpoint(
+        &self,
+        py: Python<'_>,
+        path: PathBuf,
+        scene: &PyScene,
+        camera: &PyCamera,
+        options: &PyOptions,
+    ) -> PyResult<()> {
+        let description = options_description(&options.options, &camera.camera);
+        let checkpoint = Checkpoint {
+            scene_fingerprint: scene.fingerprint,
+            options_fingerprint: hash_bytes(description.as_bytes()),
+            seed: options.options.seed,
+            options: description,
+            film: self.film.clone(),
+            stats: self.stats,
+        };
+        py.detach(|| checkpoint.save(&path)).or_py()
+    }
+
+    /// The film of a checkpoint, refused (naming what differs) unless it was rendered from the
+    /// same scene and options.
+    #[staticmethod]
+    fn load_checkpoint(path: PathBuf, scene: &PyScene, camera: &PyCamera, options: &PyOptions) -> PyResult<Self> {
+        let checkpoint = Checkpoint::load(&path).or_py()?;
+        if checkpoint.scene_fingerprint != scene.fingerprint {
+            return Err(invalid(format!(
+                "{}: cannot resume: the checkpoint was rendered from a different scene (geometry, materials or emission)",
+                path.display()
+            )));
+        }
+        let description = options_description(&options.options, &camera.camera);
+        if checkpoint.options_fingerprint != hash_bytes(description.as_bytes())
+            || checkpoint.seed != options.options.seed
+        {
+            return Err(invalid(format!(
+                "{}: cannot resume: the checkpoint was rendered with other options: {}; only spp may change",
+                path.display(),
+                differing_options(&checkpoint.options, &description).join(", ")
+            )));
+        }
+        Ok(PyFilm { film: checkpoint.film, stats: checkpoint.stats })
+    }
+}

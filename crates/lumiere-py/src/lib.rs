@@ -1,0 +1,28 @@
+//! `lumiere._lumiere`: the native half of the Python package. It only turns Python values into
+//! library calls and back; the Python half (`python/lumiere/`) gives it the API a Python user
+//! expects (numpy arrays, keyword options, pickling for Ray), so each side does what it does best.
+
+mod camera;
+mod errors;
+mod film;
+mod image;
+mod options;
+mod pixels;
+mod render;
+mod scene;
+mod watch;
+
+use pyo3::prelude::*;
+
+#[pymodule]
+fn _lumiere(module: &Bound<'_, PyModule>) -> PyResult<()> {
+    module.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    module.add_class::<scene::PyScene>()?;
+    module.add_class::<camera::PyCamera>()?;
+    module.add_class::<options::PyOptions>()?;
+    module.add_class::<film::PyFilm>()?;
+    module.add_function(wrap_pyfunction!(render::render, module)?)?;
+    module.add_function(wrap_pyfunction!(film::render_passes, module)?)?;
+    module.add_function(wrap_pyfunction!(image::write_image, module)?)?;
+    Ok(())
+}

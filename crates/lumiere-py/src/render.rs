@@ -1,0 +1,80 @@
+//! `render`: a whole render on a pool of `threads`, with the GIL released (see `watch.rs`), and the
+//! AOVs asked for; returns the image and AOVs as float32 bytes and the render's statistics.
+
+use std::sync::{Arc, Mutex};
+
+use lumiere::render::aov::{Aov, render_aovs};
+use lumiere::render::film::Film;
+use lumiere::render::{Hooks, RenderStats, render_progressive};
+use pyo3::prelude::*;
+use pyo3::types::{PyByteArray, PyDict};
+
+use crate::camera::PyCamera;
+use crate::errors::{OrPyErr, invalid};
+use crate::options::PyOptions;
+use crate::pixels::to_bytearray;
+use crate::scene::PyScene;
+use crate::watch::{self, Watch};
+
+/// A rayon pool of `threads` workers (0: one per core), as the CLI builds it, kept for the next
+/// render with that many: starting threads for every call would cost milliseconds a render.
+pub fn pool(threads: usize) -> PyResult<Arc<rayon::ThreadPool>> {
+    static POOLS: Mutex<Vec<(usize, Arc<rayon::ThreadPool>)>> = Mutex::new(Vec::new());
+    let mut pools = POOLS.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some((_, pool)) = pools.iter().find(|(n, _)| *n == threads) {
+        return Ok(pool.clone());
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| invalid(format!("cannot start {threads} threads: {e}")))?;
+    let pool = Arc::new(pool);
+    pools.push((threads, pool.clone()));
+    Ok(pool)
+}
+
+type Rendered<'py> = (Bound<'py, PyByteArray>, Vec<Bound<'py, PyByteArray>>, Bound<'py, PyDict>);
+
+#[pyfunction]
+#[pyo3(signature = (scene, camera, options, threads, aovs, progress=None))]
+pub fn render<'py>(
+    py: Python<'py>,
+    scene: &PyScene,
+    camera: &PyCamera,
+    options: &PyOptions,
+    threads: usize,
+    aovs: Vec<String>,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<Rendered<'py>> {
+    let aovs = aovs.iter().map(|name| Aov::parse(name)).collect::<lumiere::Result<Vec<_>>>().or_py()?;
+    let (world, camera, options) = (&*scene.world, &camera.camera, &options.options);
+    let pool = pool(threads)?;
+    let threads = pool.current_num_threads();
+    let pixels = u64::from(camera.width) * u64::from(camera.height);
+    let total = (options.spp != u32::MAX).then(|| pixels * u64::from(options.spp));
+    let work = |watch: &Watch| {
+        pool.install(|| {
+            let film = Film::new(camera.width, camera.height)?;
+            let count = |n| {
+                watch.done.fetch_add(n, std::sync::atomic::Ordering::Relaxed);
+            };
+            let hooks = Hooks { progress: &count, pass_done: &mut |_, _| Ok(()), cancel: &watch.cancel };
+            let output = render_progressive(world, camera, options, film, RenderStats::default(), hooks)?;
+            let buffers = if aovs.is_empty() { Vec::new() } else { render_aovs(world, camera, options, &aovs) };
+            Ok((output, buffers))
+        })
+    };
+    let (output, buffers) = watch::run(py, total, progress.as_ref(), work)?;
+    let image = to_bytearray(py, &output.image.pixels)?;
+    let buffers = buffers.iter().map(|b| to_bytearray(py, b)).collect::<PyResult<Vec<_>>>()?;
+    let stats = PyDict::new(py);
+    stats.set_item("samples", output.film.samples)?;
+    stats.set_item("rays", output.stats.rays)?;
+    stats.set_item("seconds", output.stats.elapsed.as_secs_f64())?;
+    stats.set_item("mrays_per_second", output.stats.mrays_per_second())?;
+    stats.set_item("stop", output.stop.describe())?;
+    stats.set_item("discarded", output.film.discarded)?;
+    stats.set_item("threads", threads)?;
+    stats.set_item("relative_error", output.film.relative_error())?;
+    Ok((image, buffers, stats))
+}

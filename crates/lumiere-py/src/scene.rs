@@ -1,0 +1,187 @@
+//! Scenes: loaded from a file, the built-in Cornell box, or built from arrays; each becomes a
+//! `World` (BVH and lights) at once, as the CLI does, so a render starts straight away and `info()`
+//! describes what will be rendered.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+
+use glam::{Vec2, Vec3};
+use lumiere::accel::BuildPreset;
+use lumiere::materials::Material;
+use lumiere::render::fingerprint::scene_fingerprint;
+use lumiere::scene::Scene;
+use lumiere::scene::mesh::TriangleMesh;
+use lumiere::world::World;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::errors::{OrPyErr, invalid};
+
+/// A scene ready to render (its BVH and lights built).
+#[pyclass(module = "lumiere._lumiere", name = "NativeScene", frozen)]
+pub struct PyScene {
+    pub world: Arc<World>,
+    /// The built-in scene, whose default camera is gKit's orbiter.
+    #[pyo3(get)]
+    pub builtin: bool,
+    /// The fingerprint checkpoints store: geometry and materials, emission included.
+    #[pyo3(get)]
+    pub fingerprint: u64,
+    #[pyo3(get)]
+    pub load_seconds: f64,
+    #[pyo3(get)]
+    pub build_seconds: f64,
+}
+
+/// A material given from Python: name, diffuse colour, emission.
+type MaterialSpec = (String, [f32; 3], [f32; 3]);
+
+impl PyScene {
+    /// Applies `emission`, builds the world; the GIL is released while building.
+    fn finish(
+        py: Python<'_>,
+        mut scene: Scene,
+        emission: Vec<(String, [f32; 3])>,
+        builtin: bool,
+        load: f64,
+    ) -> PyResult<Self> {
+        for (name, ke) in emission {
+            scene.set_emission(&name, Vec3::from(ke)).or_py()?;
+        }
+        let fingerprint = scene_fingerprint(&scene);
+        let start = Instant::now();
+        let world = py.detach(|| World::new(scene, BuildPreset::Default));
+        let build_seconds = start.elapsed().as_secs_f64();
+        Ok(PyScene { world: Arc::new(world), builtin, fingerprint, load_seconds: load, build_seconds })
+    }
+}
+
+#[pymethods]
+impl PyScene {
+    /// Loads an OBJ (or .obj.gz) file with its MTL, or the built-in scene when `path` is None.
+    #[staticmethod]
+    #[pyo3(signature = (path, emission))]
+    fn load(py: Python<'_>, path: Option<PathBuf>, emission: Vec<(String, [f32; 3])>) -> PyResult<Self> {
+        let start = Instant::now();
+        let builtin = path.is_none();
+        let scene = py
+            .detach(|| match &path {
+                Some(path) => Scene::load(path),
+                None => Scene::builtin(),
+            })
+            .or_py()?;
+        PyScene::finish(py, scene, emission, builtin, start.elapsed().as_secs_f64())
+    }
+
+    /// A scene from float32 positions (x, y, z per vertex), uint32 corner indices (three per
+    /// triangle), uint32 material ids (one per triangle) and the materials they index, all as
+    /// native-endian bytes; optional float32 per-vertex normals (same indices as positions).
+    #[staticmethod]
+    #[pyo3(signature = (name, positions, indices, material_ids, materials, normals=None))]
+    fn from_arrays(
+        py: Python<'_>,
+        name: String,
+        positions: &[u8],
+        indices: &[u8],
+        material_ids: &[u8],
+        materials: Vec<MaterialSpec>,
+        normals: Option<&[u8]>,
+    ) -> PyResult<Self> {
+        let start = Instant::now();
+        let floats =
+            |b: &[u8]| b.chunks_exact(4).map(|c| f32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect::<Vec<_>>();
+        let ints =
+            |b: &[u8]| b.chunks_exact(4).map(|c| u32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect::<Vec<_>>();
+        let vec3s = |v: Vec<f32>| v.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect::<Vec<_>>();
+        let positions = vec3s(floats(positions));
+        if let Some(bad) = positions.iter().position(|p| !p.is_finite()) {
+            return Err(invalid(format!("{name}: vertex {bad} is not finite")));
+        }
+        let indices: Vec<[u32; 3]> = ints(indices).chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+        let normals = normals.map(|n| vec3s(floats(n))).unwrap_or_default();
+        if !normals.is_empty() && normals.len() != positions.len() {
+            return Err(invalid(format!("{name}: {} normals for {} vertices", normals.len(), positions.len())));
+        }
+        let normal_indices = if normals.is_empty() { Vec::new() } else { indices.clone() };
+        let mesh = TriangleMesh {
+            material_ids: ints(material_ids),
+            positions,
+            indices,
+            normals,
+            normal_indices,
+            texcoords: Vec::<Vec2>::new(),
+            texcoord_indices: Vec::new(),
+        };
+        let materials = materials
+            .into_iter()
+            .map(|(name, kd, ke)| Material { kd: Vec3::from(kd), ke: Vec3::from(ke), ..Material::default_grey(&name) })
+            .collect();
+        let scene = Scene::from_parts(name, mesh, materials, Vec::new()).or_py()?;
+        PyScene::finish(py, scene, Vec::new(), false, start.elapsed().as_secs_f64())
+    }
+
+    #[getter]
+    fn name(&self) -> String {
+        self.world.scene().name.clone()
+    }
+
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.world.scene().warnings.clone()
+    }
+
+    /// What `lumiere info` prints, as a dict.
+    fn info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let scene = self.world.scene();
+        let info = PyDict::new(py);
+        info.set_item("name", &scene.name)?;
+        info.set_item("triangles", scene.mesh.triangle_count())?;
+        info.set_item("vertices", scene.mesh.positions.len())?;
+        info.set_item("normals", !scene.mesh.normal_indices.is_empty())?;
+        info.set_item("texcoords", !scene.mesh.texcoord_indices.is_empty())?;
+        let lights = self.world.lights().lights();
+        let light_info = PyDict::new(py);
+        light_info.set_item("triangles", lights.len())?;
+        light_info.set_item("area", lights.iter().map(|l| l.area).fold(0.0, |a, b| a + b))?;
+        light_info.set_item("power", lights.iter().map(|l| l.power()).fold(Vec3::ZERO, |a, b| a + b).to_array())?;
+        info.set_item("lights", light_info)?;
+        let bounds = scene.bounds();
+        if bounds.is_empty() {
+            info.set_item("bounds", py.None())?;
+        } else {
+            // `+ 0.0` turns a negative zero positive, as `lumiere info` prints it.
+            info.set_item("bounds", ((bounds.min + 0.0).to_array(), (bounds.max + 0.0).to_array()))?;
+        }
+        let mut triangles = vec![0usize; scene.materials.len()];
+        for &id in &scene.mesh.material_ids {
+            triangles[id as usize] += 1;
+        }
+        let materials = PyDict::new(py);
+        for (material, count) in scene.materials.iter().zip(triangles) {
+            if let Some(existing) = materials.get_item(&material.name)? {
+                // Two materials of one name: count their triangles together, keep the first's colours.
+                let before: usize = existing.get_item("triangles")?.extract()?;
+                existing.set_item("triangles", before + count)?;
+                continue;
+            }
+            let entry = PyDict::new(py);
+            entry.set_item("triangles", count)?;
+            entry.set_item("kd", material.kd.to_array())?;
+            entry.set_item("ke", material.ke.to_array())?;
+            entry.set_item("texture", material.map_kd.as_ref().map(|p| p.display().to_string()))?;
+            entry.set_item("light", material.is_emissive())?;
+            materials.set_item(&material.name, entry)?;
+        }
+        info.set_item("materials", materials)?;
+        info.set_item("warnings", scene.warnings.clone())?;
+        info.set_item("load_seconds", self.load_seconds)?;
+        info.set_item("build_seconds", self.build_seconds)?;
+        Ok(info)
+    }
+
+    fn __repr__(&self) -> String {
+        let scene = self.world.scene();
+        format!("<lumiere scene {:?}: {} triangles>", scene.name, scene.mesh.triangle_count())
+    }
+}

@@ -1,0 +1,109 @@
+//! Long work with the GIL released, still answering Python: the work runs on a thread of its own
+//! while the calling thread sleeps without the GIL, waking every few milliseconds to check for
+//! signals (Ctrl-C raises `KeyboardInterrupt`, as Python code would) and to call the progress
+//! callback. A signal or an exception from the callback sets the cancel flag, which the library
+//! polls inside passes, and is raised once the work has stopped.
+
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{Condvar, Mutex};
+use std::time::Duration;
+
+use pyo3::prelude::*;
+
+use crate::errors::to_py;
+
+/// How often the waiting thread checks signals and reports progress.
+const POLL: Duration = Duration::from_millis(25);
+
+/// What the work sees: the cancel flag to pass to the library, and a counter of samples done.
+pub struct Watch {
+    pub cancel: AtomicBool,
+    pub done: AtomicU64,
+}
+
+/// Runs `work` on a new thread; calls `progress(done, total)` as `watch.done` moves (and once at
+/// the end). The result of `work`, or the first signal or callback exception.
+pub fn run<T: Send>(
+    py: Python<'_>,
+    total: Option<u64>,
+    progress: Option<&Bound<'_, PyAny>>,
+    work: impl FnOnce(&Watch) -> lumiere::Result<T> + Send,
+) -> PyResult<T> {
+    let watch = Watch { cancel: AtomicBool::new(false), done: AtomicU64::new(0) };
+    let finished = Finished::default();
+    let mut failure: Option<PyErr> = None;
+    let mut reported = None;
+    let result = std::thread::scope(|scope| {
+        let (watch, finished) = (&watch, &finished);
+        let worker = scope.spawn(move || {
+            // Dropped when the work returns or panics: either way the waiting thread wakes.
+            let _signal = SignalOnDrop(finished);
+            work(watch)
+        });
+        loop {
+            let over = py.detach(|| finished.wait(POLL));
+            if failure.is_none() {
+                let step = py.check_signals().and_then(|()| report(progress, &watch.done, total, &mut reported));
+                if let Err(e) = step {
+                    watch.cancel.store(true, Ordering::SeqCst);
+                    failure = Some(e);
+                }
+            }
+            if over {
+                break;
+            }
+        }
+        py.detach(|| worker.join())
+    });
+    let result = match result {
+        Ok(result) => result,
+        Err(panic) => std::panic::resume_unwind(panic),
+    };
+    if let Some(e) = failure {
+        return Err(e);
+    }
+    let value = result.map_err(to_py)?;
+    report(progress, &watch.done, total, &mut reported)?;
+    Ok(value)
+}
+
+/// Calls the callback if the count moved since the last call.
+fn report(
+    progress: Option<&Bound<'_, PyAny>>,
+    done: &AtomicU64,
+    total: Option<u64>,
+    reported: &mut Option<u64>,
+) -> PyResult<()> {
+    let Some(callback) = progress else { return Ok(()) };
+    let now = done.load(Ordering::Relaxed);
+    if *reported != Some(now) {
+        *reported = Some(now);
+        callback.call1((now, total))?;
+    }
+    Ok(())
+}
+
+/// Set once the work is over, waking the waiting thread at once rather than at its next poll.
+#[derive(Default)]
+struct Finished {
+    over: Mutex<bool>,
+    wake: Condvar,
+}
+
+impl Finished {
+    /// Waits up to `timeout`; whether the work is over.
+    fn wait(&self, timeout: Duration) -> bool {
+        let over = self.over.lock().unwrap_or_else(|e| e.into_inner());
+        let (over, _) = self.wake.wait_timeout_while(over, timeout, |over| !*over).unwrap_or_else(|e| e.into_inner());
+        *over
+    }
+}
+
+struct SignalOnDrop<'a>(&'a Finished);
+
+impl Drop for SignalOnDrop<'_> {
+    fn drop(&mut self) {
+        *self.0.over.lock().unwrap_or_else(|e| e.into_inner()) = true;
+        self.0.wake.notify_all();
+    }
+}

@@ -1,0 +1,141 @@
+"""lumiere.distributed on a real Ray cluster on 127.0.0.1 (a head and one more node, one CPU
+each, started here and stopped at the end): the bytes of a local render whatever the split, a
+worker killed mid-task changes nothing, checkpoints the CLI resumes, and a clear error when no
+cluster answers."""
+
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import lumiere
+
+from conftest import optional  # noqa: E402
+
+ray = optional("ray", "pip install 'lumiere[ray]'")
+from ray.cluster_utils import Cluster  # noqa: E402
+
+import lumiere.distributed as distributed  # noqa: E402
+from conftest import read_pfm  # noqa: E402
+
+
+def bits(image):
+    return np.ascontiguousarray(image, dtype=np.float32).view(np.uint32)
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    """A head node and a worker node, separate raylet processes on 127.0.0.1, one CPU each."""
+    start = time.perf_counter()
+    cluster = Cluster(
+        initialize_head=True,
+        head_node_args={"num_cpus": 1, "include_dashboard": False, "node_ip_address": "127.0.0.1"},
+    )
+    try:
+        cluster.add_node(num_cpus=1, node_ip_address="127.0.0.1")
+        ray.init(address=cluster.address, logging_level="warning")
+        assert len([n for n in ray.nodes() if n["Alive"]]) == 2
+        assert time.perf_counter() - start < 120, "the cluster started in time"
+        yield cluster
+    finally:
+        ray.shutdown()
+        cluster.shutdown()
+
+
+def test_bytes_equal_a_local_render_whatever_the_split(cluster):
+    scene = lumiere.builtin()
+    local = lumiere.render(scene, spp=12, size=(64, 48), seed=4)
+    for tasks in (1, 5, 12):
+        result = distributed.render_full(scene, spp=12, size=(64, 48), seed=4, address=cluster.address, tasks=tasks)
+        assert np.array_equal(bits(result.image), bits(local)), f"{tasks} tasks"
+        assert result.stats["samples"] == 12 and len(result.stats["tasks"]) == tasks
+    # Another technique, another camera, a scene from arrays.
+    camera = lumiere.Camera.look_at((0, 1, 3.5), (0, 1, 0), size=(40, 30))
+    local = lumiere.render(scene, camera, mode="direct", spp=5, samples=2)
+    remote = distributed.render(scene, camera, mode="direct", spp=5, samples=2, address=cluster.address, tasks=3)
+    assert np.array_equal(bits(remote), bits(local))
+
+
+def _render_processes():
+    """Pids of Ray workers running a lumiere task (Ray titles them ray::<function>)."""
+    pids = []
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                with open(f"/proc/{entry}/cmdline", "rb") as file:
+                    if file.read().startswith(b"ray::_render_range"):
+                        pids.append(int(entry))
+            except OSError:
+                pass
+    return pids
+
+
+def test_a_worker_killed_mid_task_changes_nothing(cluster):
+    scene = lumiere.builtin()
+    options = dict(spp=96, size=(96, 72), seed=2)
+    local = lumiere.render(scene, **options)
+    killed = []
+
+    def kill_one():
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline and not killed:
+            for pid in _render_processes():
+                os.kill(pid, signal.SIGKILL)
+                killed.append(pid)
+                break
+            time.sleep(0.05)
+
+    killer = threading.Thread(target=kill_one)
+    killer.start()
+    result = distributed.render_full(scene, address=cluster.address, tasks=4, max_retries=3, **options)
+    killer.join()
+    assert killed, "a worker was running a task and was killed"
+    assert np.array_equal(bits(result.image), bits(local))
+
+
+def test_the_merged_checkpoint_resumes_in_the_cli(cluster, cli, tmp_path):
+    checkpoint = tmp_path / "merged.ckpt"
+    scene = lumiere.builtin()
+    distributed.render(scene, spp=3, size=(32, 24), address=cluster.address, checkpoint=str(checkpoint))
+    # Continued to 6 spp by the CLI, then by the distributed driver: both equal a straight render.
+    cli("render", "--size", "32x24", "--spp", "6", "--checkpoint", tmp_path / "cli.ckpt", "--resume", checkpoint,
+        "-o", tmp_path / "resumed.pfm")
+    straight = lumiere.render(scene, spp=6, size=(32, 24))
+    assert np.array_equal(bits(read_pfm(tmp_path / "resumed.pfm")), bits(straight))
+    resumed = distributed.render(scene, spp=6, size=(32, 24), address=cluster.address, checkpoint=str(checkpoint), resume=True)
+    assert np.array_equal(bits(resumed), bits(straight))
+    with pytest.raises(lumiere.LumiereError, match="seed"):
+        distributed.render(scene, spp=8, seed=1, size=(32, 24), address=cluster.address, checkpoint=str(checkpoint), resume=True)
+
+
+def test_the_command_line_writes_the_cli_bytes(cluster, cli, tmp_path):
+    args = ["--size", "40x30", "--spp", "4", "--mode", "ao", "--samples", "2"]
+    cli("render", *args, "-o", tmp_path / "cli.pfm")
+    command = [sys.executable, "-m", "lumiere.distributed", "render", *args, "--address", cluster.address,
+               "-o", str(tmp_path / "ray.pfm")]
+    subprocess.run(command, check=True, capture_output=True, timeout=120)
+    assert (tmp_path / "ray.pfm").read_bytes() == (tmp_path / "cli.pfm").read_bytes()
+
+
+def test_a_clear_error_when_no_cluster_is_reachable(tmp_path):
+    # A port nothing listens on (the process must not be connected already, hence a subprocess).
+    command = [sys.executable, "-m", "lumiere.distributed", "render", "--address", "127.0.0.1:9", "--spp", "1",
+               "--size", "8x6", "-o", str(tmp_path / "x.pfm")]
+    start = time.perf_counter()
+    result = subprocess.run(command, capture_output=True, text=True, timeout=120)
+    assert result.returncode == 2
+    assert "no Ray cluster reachable at 127.0.0.1:9" in result.stderr
+    assert time.perf_counter() - start < 60
+    assert not (tmp_path / "x.pfm").exists()
+
+
+def test_bad_arguments_are_refused_before_connecting():
+    with pytest.raises(lumiere.LumiereError, match="spp must be at least 1"):
+        distributed.render(lumiere.builtin(), spp=0, address="127.0.0.1:9")
+    with pytest.raises(lumiere.LumiereError, match="tasks must be an integer of at least 1"):
+        distributed.render(lumiere.builtin(), spp=2, tasks=0, address="127.0.0.1:9")

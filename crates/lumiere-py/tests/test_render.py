@@ -1,0 +1,222 @@
+"""lumiere.render: shapes and types, the CLI's exact values, options, errors, progress, the GIL
+and Ctrl-C."""
+
+import pickle
+import signal
+import subprocess
+import sys
+import textwrap
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import lumiere
+from conftest import read_pfm
+
+
+def bits(image):
+    return np.ascontiguousarray(image, dtype=np.float32).view(np.uint32)
+
+
+def test_three_lines_render_the_cornell_box():
+    image = lumiere.render(lumiere.builtin(), spp=2, size=(64, 48))
+    assert image.shape == (48, 64, 3)
+    assert image.dtype == np.float32
+    assert image.flags.c_contiguous and image.flags.writeable
+    assert np.isfinite(image).all() and image.mean() > 0.05, "the lit box is not black"
+
+
+@pytest.mark.parametrize(
+    "flags, kwargs",
+    [
+        (["--spp", "4"], dict(spp=4)),
+        (["--mode", "direct", "--samples", "3", "--seed", "5"], dict(mode="direct", spp=1, samples=3, seed=5)),
+        (
+            ["--mode", "ao", "--samples", "2", "--spp", "3", "--sampler", "sobol", "--ao-distance", "0.5"],
+            dict(mode="ao", spp=3, samples=2, sampler="sobol", ao_distance=0.5),
+        ),
+        (["--mode", "shadows"], dict(mode="shadows", spp=1)),
+        (["--spp", "2", "--max-depth", "3", "--seed", "9"], dict(spp=2, max_depth=3, seed=9)),
+    ],
+)
+def test_values_are_the_cli_pfm_bit_for_bit(cli, tmp_path, flags, kwargs):
+    out = tmp_path / "cli.pfm"
+    cli("render", "--size", "48x36", *flags, "-o", out)
+    image = lumiere.render(lumiere.builtin(), size=(48, 36), **kwargs)
+    assert np.array_equal(bits(image), bits(read_pfm(out)))
+
+
+def test_a_look_at_camera_and_a_scene_file_match_the_cli(cli, tmp_path):
+    obj = tmp_path / "tri.obj"
+    obj.write_text("mtllib tri.mtl\nv -1 0 -1\nv 1 0 -1\nv 0 0 1\nv -1 2 -1\nv 1 2 -1\nv 0 2 1\n"
+                   "usemtl floor\nf 1 3 2\nusemtl lamp\nf 4 5 6\n")
+    (tmp_path / "tri.mtl").write_text("newmtl floor\nKd 0.5 0.5 0.5\nnewmtl lamp\nKd 0 0 0\nKe 4 4 4\n")
+    out = tmp_path / "cli.pfm"
+    cli("render", obj, "--size", "32x24", "--spp", "2", "--eye", "0,1,4", "--target", "0,1,0", "--fov", "50",
+        "--emission", "lamp=6,6,6", "-o", out)
+    scene = lumiere.load(obj, emission={"lamp": (6, 6, 6)})
+    camera = lumiere.Camera.look_at((0, 1, 4), (0, 1, 0), fov=50, size=(32, 24))
+    assert np.array_equal(bits(lumiere.render(scene, camera, spp=2)), bits(read_pfm(out)))
+    # Without a camera: the CLI's framing view.
+    cli("render", obj, "--size", "32x24", "--spp", "1", "--mode", "materials", "-o", out)
+    framed = lumiere.render(lumiere.load(obj), mode="materials", spp=1, size=(32, 24))
+    assert np.array_equal(bits(framed), bits(read_pfm(out)))
+
+
+def test_same_seed_same_bits_for_any_thread_count():
+    scene = lumiere.builtin()
+    one = lumiere.render(scene, spp=3, size=(40, 30), threads=1)
+    two = lumiere.render(scene, spp=3, size=(40, 30), threads=2)
+    other = lumiere.render(scene, spp=3, size=(40, 30), seed=1)
+    assert np.array_equal(bits(one), bits(two))
+    assert not np.array_equal(bits(one), bits(other))
+
+
+def test_aovs_come_back_as_a_dict_of_arrays():
+    out = lumiere.render(lumiere.builtin(), spp=2, size=(32, 24), aovs=("albedo", "normal", "depth"))
+    assert set(out) == {"color", "albedo", "normal", "depth"}
+    assert out["albedo"].shape == out["normal"].shape == (24, 32, 3) and out["depth"].shape == (24, 32)
+    assert all(a.dtype == np.float32 for a in out.values())
+    assert 0 <= out["albedo"].min() and out["albedo"].max() <= 1
+    lengths = np.linalg.norm(out["normal"], axis=2)
+    assert np.all(lengths < 1.01) and np.mean(lengths > 0.99) > 0.5, "unit normals where the rays hit"
+    assert np.array_equal(bits(out["color"]), bits(lumiere.render(lumiere.builtin(), spp=2, size=(32, 24))))
+
+
+def test_scene_from_arrays_and_info():
+    vertices = np.array([[-1, 0, -1], [1, 0, -1], [0, 0, 1], [-1, 2, -1], [1, 2, -1], [0, 2, 1]], dtype=np.float64)
+    triangles = np.array([[0, 2, 1], [3, 4, 5]])
+    scene = lumiere.Scene.from_arrays(
+        vertices, triangles, materials=["floor", {"name": "lamp", "kd": (0, 0, 0), "ke": (5, 5, 5)}], material_ids=[0, 1]
+    )
+    info = scene.info()
+    assert info["triangles"] == 2 and info["vertices"] == 6
+    assert set(info["materials"]) == {"floor", "lamp"} and info["materials"]["lamp"]["light"]
+    assert info["lights"]["triangles"] == 1
+    assert info["bounds"] == ([-1.0, 0.0, -1.0], [1.0, 2.0, 1.0])
+    camera = lumiere.Camera.look_at((0, 1, 4), (0, 1, 0), size=(16, 12))
+    image = lumiere.render(scene, camera, spp=2)
+    assert image.shape == (12, 16, 3) and image.max() > 0
+    # Pickled scenes and cameras (what Ray ships) rebuild to the same render.
+    again = lumiere.render(pickle.loads(pickle.dumps(scene)), pickle.loads(pickle.dumps(camera)), spp=2)
+    assert np.array_equal(bits(image), bits(again))
+    with pytest.raises(lumiere.LumiereError, match="triangles index vertices 0..5"):
+        lumiere.Scene.from_arrays(vertices, [[0, 1, 6]])
+    with pytest.raises(lumiere.LumiereError, match=r"vertices must have shape \(N, 3\)"):
+        lumiere.Scene.from_arrays(np.zeros((4, 2)), [[0, 1, 2]])
+
+
+def test_builtin_info_lists_materials_by_name():
+    info = lumiere.builtin().info()
+    assert info["triangles"] == 32 and info["lights"]["triangles"] == 2
+    assert "light.001" in info["materials"] and info["materials"]["light.001"]["light"]
+
+
+def test_errors_carry_the_cli_message(cli, tmp_path):
+    missing = tmp_path / "missing.obj"
+    with pytest.raises(lumiere.LumiereOSError) as error:
+        lumiere.load(missing)
+    assert isinstance(error.value, OSError) and isinstance(error.value, lumiere.LumiereError)
+    assert error.value.errno == 2 and error.value.filename == str(missing)
+    cli_error = cli("render", missing, "-o", tmp_path / "x.pfm", check=False).stderr.strip().splitlines()[-1]
+    assert cli_error == f"lumiere: error: {error.value}"
+
+    bad = tmp_path / "bad.obj"
+    bad.write_text("v 0 0 0\nv 1 0 0\nf 1 2 9\n")
+    with pytest.raises(lumiere.LumiereError) as error:
+        lumiere.load(bad)
+    assert not isinstance(error.value, OSError)
+    cli_error = cli("render", bad, "-o", tmp_path / "x.pfm", check=False).stderr.strip().splitlines()[-1]
+    assert cli_error == f"lumiere: error: {error.value}"
+
+    with pytest.raises(lumiere.LumiereError, match="same point"):
+        lumiere.Camera.look_at((0, 0, 0), (0, 0, 0))
+    with pytest.raises(lumiere.LumiereError, match="unknown mode"):
+        lumiere.render(lumiere.builtin(), mode="nope")
+    with pytest.raises(lumiere.LumiereError, match="at least 1"):
+        lumiere.render(lumiere.builtin(), spp=0)
+    with pytest.raises(lumiere.LumiereError, match="unknown AOV"):
+        lumiere.render(lumiere.builtin(), spp=1, size=(8, 6), aovs=("speed",))
+    with pytest.raises(TypeError, match="technique options are"):
+        lumiere.render(lumiere.builtin(), spp=1, sample=3)
+    with pytest.warns(UserWarning, match="samples has no effect"):
+        lumiere.render(lumiere.builtin(), spp=1, size=(8, 6), samples=4)
+
+
+def test_progress_is_reported_and_an_exception_stops_the_render():
+    calls = []
+    lumiere.render(lumiere.builtin(), spp=4, size=(64, 48), progress=lambda done, total: calls.append((done, total)))
+    assert calls[-1] == (64 * 48 * 4, 64 * 48 * 4)
+    assert all(a[0] <= b[0] for a, b in zip(calls, calls[1:]))
+
+    class Stop(Exception):
+        pass
+
+    def stop(done, total):
+        if done > 0:
+            raise Stop
+
+    start = time.perf_counter()
+    with pytest.raises(Stop):
+        lumiere.render(lumiere.builtin(), spp=100_000, size=(64, 48), progress=stop)
+    assert time.perf_counter() - start < 10
+
+
+def test_the_gil_is_released_while_rendering():
+    ticks = []
+    running = threading.Event()
+
+    def count():
+        running.set()
+        while not done.is_set():
+            ticks.append(1)
+            time.sleep(0.001)
+
+    done = threading.Event()
+    thread = threading.Thread(target=count)
+    thread.start()
+    running.wait()
+    before = len(ticks)
+    lumiere.render(lumiere.builtin(), spp=16, size=(128, 96), threads=1)
+    during = len(ticks) - before
+    done.set()
+    thread.join()
+    assert during > 20, "a Python thread kept running during the render"
+
+
+def test_ctrl_c_stops_the_render_and_raises_keyboard_interrupt(tmp_path):
+    script = textwrap.dedent(
+        """
+        import sys, lumiere
+        def progress(done, total):
+            if not progress.said:
+                print("started", flush=True)
+                progress.said = True
+        progress.said = False
+        try:
+            lumiere.render(lumiere.builtin(), spp=1_000_000, size=(128, 96), progress=progress)
+        except KeyboardInterrupt:
+            print("KeyboardInterrupt", flush=True)
+            sys.exit(7)
+        """
+    )
+    child = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
+    try:
+        assert child.stdout.readline().strip() == "started"
+        sent = time.perf_counter()
+        child.send_signal(signal.SIGINT)
+        assert child.wait(timeout=20) == 7
+        assert child.stdout.read().strip() == "KeyboardInterrupt"
+        assert time.perf_counter() - sent < 5, "the render stopped promptly"
+    finally:
+        child.kill()
+
+
+def test_write_image_writes_the_cli_bytes(cli, tmp_path):
+    for extension in ("pfm", "png", "exr"):
+        cli("render", "--size", "32x24", "--spp", "2", "-o", tmp_path / f"cli.{extension}")
+        image = lumiere.render(lumiere.builtin(), spp=2, size=(32, 24))
+        lumiere.write_image(tmp_path / f"py.{extension}", image)
+        assert (tmp_path / f"py.{extension}").read_bytes() == (tmp_path / f"cli.{extension}").read_bytes(), extension
