@@ -97,7 +97,7 @@ pub struct InfoArgs {
 pub enum ModeArg {
     /// White where a camera ray hits a triangle, black elsewhere.
     Hits,
-    /// Diffuse colour (Kd) of the hit triangle.
+    /// Colour of the hit surface: its albedo, texture included (Kd for the lab's diffuse scenes).
     Materials,
     /// Hard shadows: one shadow ray to each light triangle's centroid.
     Shadows,
