@@ -232,6 +232,12 @@ pub struct RenderArgs {
     #[arg(long, value_delimiter = ',', value_parser = parse_aov)]
     pub aov: Vec<Aov>,
 
+    /// Denoise the image with Intel Open Image Denoise (its RT filter, guided by the albedo and
+    /// normal AOVs), loaded at run time: `pip install pyoidn` or set OIDN_DIR. An .exr output keeps
+    /// the noisy image as the `noisy` layer.
+    #[arg(long)]
+    pub denoise: bool,
+
     /// Write render statistics (mode, size, rays, timings) as JSON to this file; `-` for stdout.
     #[arg(long)]
     pub stats_json: Option<PathBuf>,

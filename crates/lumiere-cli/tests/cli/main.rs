@@ -9,6 +9,7 @@ mod harness;
 mod process;
 
 mod cli;
+mod denoise;
 mod edges;
 mod fuzz_corpus;
 mod fuzz_parsers;

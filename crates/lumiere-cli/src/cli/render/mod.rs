@@ -2,6 +2,7 @@
 
 mod camera;
 mod checkpointing;
+mod oidn;
 mod options;
 mod paths;
 mod report;
@@ -9,6 +10,7 @@ mod signals;
 
 use std::time::Instant;
 
+use glam::Vec3;
 use lumiere::Result;
 use lumiere::accel::BuildPreset;
 use lumiere::image_io::{ExrLayer, PngEncoding, PngStyle, Tonemap, write_exr_with_layers, write_image};
@@ -33,12 +35,14 @@ pub fn run(args: &RenderArgs) -> Result<u8> {
     signals::install();
     // Refuse bad or clashing paths before spending minutes on a render.
     paths::check(args)?;
+    // Likewise a denoiser that is not there.
+    let denoiser = if args.denoise { Some(oidn::Oidn::load()?) } else { None };
     let pool = super::pool(args.threads)?;
     let threads = pool.current_num_threads();
-    pool.install(|| render(args, threads))
+    pool.install(|| render(args, threads, denoiser.as_ref()))
 }
 
-fn render(args: &RenderArgs, threads: usize) -> Result<u8> {
+fn render(args: &RenderArgs, threads: usize, denoiser: Option<&oidn::Oidn>) -> Result<u8> {
     for ignored in options::ignored_flags(args) {
         output::warn(ignored);
     }
@@ -62,7 +66,7 @@ fn render(args: &RenderArgs, threads: usize) -> Result<u8> {
     signals::rendering_starts();
     let output = render_passes(args, &world, &camera, &options, &fingerprints, film, stats)?;
     report::warn_if_black(&output);
-    write_output(args, &world, &camera, &options, &output)?;
+    write_output(args, &world, &camera, &options, &output, denoiser)?;
     if let Some(path) = &args.checkpoint {
         fingerprints.save(path, &output.film, &output.stats)?;
     }
@@ -130,34 +134,62 @@ fn render_passes(
     output
 }
 
-/// The image, with its AOVs as extra EXR channels when asked for.
+/// The image (denoised with `--denoise`), with its AOVs as extra EXR channels when asked for, and
+/// the noisy image as the `noisy` layer of a denoised EXR.
 fn write_output(
     args: &RenderArgs,
     world: &World,
     camera: &Camera,
     options: &RenderOptions,
     output: &RenderOutput,
+    denoiser: Option<&oidn::Oidn>,
 ) -> Result<()> {
     let image = &output.image;
-    if args.aov.is_empty() {
-        return write_image(&args.output, image.width, image.height, &image.pixels, png_style(args));
+    let mut wanted = args.aov.clone();
+    if denoiser.is_some() {
+        for aov in [Aov::Albedo, Aov::Normal] {
+            if !wanted.contains(&aov) {
+                wanted.push(aov);
+            }
+        }
     }
-    let buffers = render_aovs(world, camera, options, &args.aov);
-    let layers: Vec<ExrLayer> = args
+    let buffers = if wanted.is_empty() { Vec::new() } else { render_aovs(world, camera, options, &wanted) };
+    let buffer = |aov: Aov| -> &[Vec3] {
+        let index = wanted.iter().position(|w| *w == aov).expect("the AOV was asked for");
+        &buffers[index]
+    };
+    let denoised = match denoiser {
+        Some(oidn) => {
+            let start = Instant::now();
+            let pixels =
+                oidn.denoise(image.width, image.height, &image.pixels, buffer(Aov::Albedo), buffer(Aov::Normal))?;
+            output::note(format_args!("denoised in {:.1} ms", start.elapsed().as_secs_f64() * 1e3));
+            Some(pixels)
+        }
+        None => None,
+    };
+    let pixels = denoised.as_deref().unwrap_or(&image.pixels);
+    let mut layers: Vec<ExrLayer> = args
         .aov
         .iter()
-        .zip(&buffers)
-        .map(|(aov, pixels)| ExrLayer {
+        .map(|&aov| ExrLayer {
             name: aov.name(),
             channels: match aov {
                 Aov::Albedo => &["R", "G", "B"],
                 Aov::Normal => &["X", "Y", "Z"],
                 Aov::Depth => &["Z"],
             },
-            pixels,
+            pixels: buffer(aov),
         })
         .collect();
-    write_exr_with_layers(&args.output, image.width, image.height, &image.pixels, &layers)
+    let exr = args.output.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    if denoised.is_some() && exr {
+        layers.push(ExrLayer { name: "noisy", channels: &["R", "G", "B"], pixels: &image.pixels });
+    }
+    if layers.is_empty() {
+        return write_image(&args.output, image.width, image.height, pixels, png_style(args));
+    }
+    write_exr_with_layers(&args.output, image.width, image.height, pixels, &layers)
 }
 
 fn png_style(args: &RenderArgs) -> PngStyle {

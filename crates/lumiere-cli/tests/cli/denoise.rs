@@ -1,0 +1,105 @@
+//! `lumiere render --denoise`: a clear error before rendering when Intel Open Image Denoise is not
+//! there, and a denoised image closer to a converged one than the noisy render when it is.
+//!
+//! OIDN is found as the binary finds it (`OIDN_DIR`, or `python3`'s pyoidn); without it the second
+//! test says it is skipped, unless `LUMIERE_REQUIRE_EXTRAS=1` makes that a failure.
+
+use std::fs;
+use std::path::Path;
+use std::process::{Command, Output};
+use std::time::{Duration, Instant};
+
+use crate::common::TempDir;
+
+fn lumiere() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_lumiere"))
+}
+
+fn stderr(output: &Output) -> String {
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+/// Reads a PFM written by lumiere as its floats (the row order does not matter here).
+fn read_pfm(path: &Path) -> Vec<f32> {
+    let bytes = fs::read(path).unwrap();
+    let mut header_end = 0;
+    let mut newlines = 0;
+    while newlines < 3 {
+        newlines += usize::from(bytes[header_end] == b'\n');
+        header_end += 1;
+    }
+    bytes[header_end..].chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect()
+}
+
+fn rmse(a: &[f32], b: &[f32]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    let sum: f64 = a.iter().zip(b).map(|(x, y)| f64::from(x - y).powi(2)).sum();
+    (sum / a.len() as f64).sqrt()
+}
+
+#[test]
+fn denoise_without_oidn_fails_before_rendering() {
+    let dir = TempDir::new("denoise-missing");
+    fs::create_dir(dir.path("empty")).unwrap();
+    let image = dir.path("out.png");
+    let start = Instant::now();
+    // A render that would take minutes: the error must come before it.
+    let out = lumiere()
+        .args(["render", "--denoise", "--spp", "100000", "--size", "512x384", "-o"])
+        .arg(&image)
+        .env("OIDN_DIR", dir.path("empty"))
+        .env("LUMIERE_NO_PYOIDN", "1")
+        .output()
+        .unwrap();
+    let text = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{text}");
+    assert_eq!(text.lines().count(), 1, "one line: {text}");
+    assert!(text.contains("Open Image Denoise") && text.contains("pip install pyoidn"), "{text}");
+    assert!(text.contains("OIDN_DIR"), "{text}");
+    assert!(!text.contains("panicked"), "{text}");
+    assert!(!image.exists(), "no output file");
+    assert!(start.elapsed() < Duration::from_secs(20), "took {:?}", start.elapsed());
+}
+
+#[test]
+fn denoising_four_samples_comes_closer_to_the_converged_image() {
+    let dir = TempDir::new("denoise-rmse");
+    let render = |extra: &[&str], name: &str| -> Output {
+        lumiere()
+            .args(["render", "--size", "128x96", "-o"])
+            .arg(dir.path(name))
+            .args(extra)
+            .output()
+            .expect("the binary runs")
+    };
+    let denoised = render(&["--spp", "4", "--denoise"], "denoised.pfm");
+    if denoised.status.code() == Some(2) && stderr(&denoised).contains("was not found") {
+        let why = stderr(&denoised);
+        assert!(
+            std::env::var("LUMIERE_REQUIRE_EXTRAS").as_deref() != Ok("1"),
+            "LUMIERE_REQUIRE_EXTRAS=1 but OIDN is missing: {why}"
+        );
+        eprintln!("skipped: OIDN is not available (pip install pyoidn or set OIDN_DIR): {why}");
+        return;
+    }
+    assert!(denoised.status.success(), "{}", stderr(&denoised));
+    assert!(stderr(&denoised).contains("denoised in"), "{}", stderr(&denoised));
+    let raw = render(&["--spp", "4"], "raw.pfm");
+    assert!(raw.status.success(), "{}", stderr(&raw));
+    // A reference of another seed, so that its noise does not share the first four samples.
+    let reference = render(&["--spp", "64", "--seed", "1"], "reference.pfm");
+    assert!(reference.status.success(), "{}", stderr(&reference));
+
+    let reference = read_pfm(&dir.path("reference.pfm"));
+    let raw_error = rmse(&read_pfm(&dir.path("raw.pfm")), &reference);
+    let denoised_error = rmse(&read_pfm(&dir.path("denoised.pfm")), &reference);
+    eprintln!("RMSE against 64 spp: raw 4 spp {raw_error:.5}, denoised {denoised_error:.5}");
+    assert!(denoised_error < 0.75 * raw_error, "raw {raw_error}, denoised {denoised_error}");
+
+    // An EXR keeps the noisy image as a layer beside the denoised one and the asked-for AOVs.
+    let exr = render(&["--spp", "4", "--denoise", "--aov", "depth"], "denoised.exr");
+    assert!(exr.status.success(), "{}", stderr(&exr));
+    let bytes = fs::read(dir.path("denoised.exr")).unwrap();
+    let has = |name: &[u8]| bytes.windows(name.len()).any(|w| w == name);
+    assert!(has(b"noisy.R\0") && has(b"depth.Z\0"), "the EXR's channels");
+}
