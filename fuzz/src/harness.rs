@@ -143,6 +143,7 @@ pub fn scene_target(data: &[u8]) -> Result<(), String> {
         Technique::Shadows(Default::default()),
         Technique::direct(1),
         Technique::ambient_occlusion(1),
+        Technique::Path(Default::default()),
     ];
     for mode in techniques {
         let output = render(&world, &camera, &RenderOptions::new(mode), &|_| {})
