@@ -1,6 +1,6 @@
 #!/bin/bash
 # Side by side (BENCHMARKS.md, "Beside Embree"): lumiere (render_ms from --stats-json, median of 3) and embree_native --packet 1 (median of 3), per lab row, 2 threads.
-cd /work/main
+cd "$(dirname "$0")/.."
 L=target/release/lumiere; E=${EMBREE_NATIVE:-/tmp/embree-native/embree_native}
 median() { sort -n | awk '{a[NR]=$1} END{print a[int((NR+1)/2)]}'; }
 row() { label=$1; lmode=$2; emode=$3; n=$4
