@@ -5,13 +5,14 @@
 //! camera samples (up to [`AOV_SAMPLES`] per pixel), so they line up with the image and cost a few
 //! first-hit rays per pixel whatever the technique.
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::materials::Bsdf;
 use crate::render::RenderOptions;
-use crate::sampler::{SampleStream, Sampler};
+use crate::render::camera_sample;
+use crate::sampler::Sampler;
 use crate::scene::camera::Camera;
 use crate::world::World;
 
@@ -62,10 +63,7 @@ pub fn render_aovs(world: &World, camera: &Camera, options: &RenderOptions, aovs
                 .map(|x| {
                     let mut sum = [Vec3::ZERO; 3];
                     for sample in 0..samples {
-                        // The same first dimension as the render's camera sample `sample`.
-                        let jitter = SampleStream::new(&sampler, y * width + x, sample).next_2d();
-                        let offset = if centre { Vec2::splat(0.5) } else { jitter };
-                        let ray = camera.ray(x as f32 + offset.x, y as f32 + offset.y);
+                        let (ray, _) = camera_sample(camera, &sampler, (x, y), sample, centre);
                         let Some(hit) = world.intersect(&ray) else { continue };
                         let surface = world.surface(&ray, &hit);
                         sum[0] += world.bsdf(&surface).albedo();

@@ -38,6 +38,7 @@ use rayon::prelude::*;
 use crate::accel::OriginBatch;
 use crate::error::{Error, Result};
 use crate::integrators::{Integrator, SampleContext};
+use crate::math::Ray;
 use crate::sampler::{SampleStream, Sampler};
 use crate::scene::camera::Camera;
 use crate::world::World;
@@ -219,6 +220,23 @@ struct Pass<'a> {
     pixel_centre: bool,
 }
 
+/// The camera ray of sample `sample` of pixel `(x, y)`, and that sample's random numbers with the
+/// pixel position already drawn from their first dimension (drawn even for pixel centres, so that
+/// the integrator's dimensions do not depend on it). The one place a sample's position is decided:
+/// the render and its AOVs go through it, so they line up.
+pub(crate) fn camera_sample<'a>(
+    camera: &Camera,
+    sampler: &'a Sampler,
+    (x, y): (u32, u32),
+    sample: u32,
+    pixel_centre: bool,
+) -> (Ray, SampleStream<'a>) {
+    let mut stream = SampleStream::new(sampler, y * camera.width + x, sample);
+    let jitter = stream.next_points(1);
+    let offset = if pixel_centre { glam::Vec2::splat(0.5) } else { jitter.get_2d(0) };
+    (camera.ray(x as f32 + offset.x, y as f32 + offset.y), stream)
+}
+
 /// One sample per pixel: per tile, its values row by row and its rays; `None` as soon as
 /// `stop_now` says so (checked before every pixel, and by integrators inside costly pixels).
 fn render_pass<I: Integrator>(
@@ -242,12 +260,8 @@ fn render_pass<I: Integrator>(
                     if stop_now().is_some() {
                         return None;
                     }
-                    ctx.stream = SampleStream::new(pass.sampler, y * camera.width + x, pass.sample);
-                    // The first dimension is the position in the pixel, drawn even for pixel centres
-                    // so that the integrator's dimensions do not depend on it.
-                    let jitter = ctx.stream.next_points(1);
-                    let offset = if pass.pixel_centre { glam::Vec2::splat(0.5) } else { jitter.get_2d(0) };
-                    let ray = camera.ray(x as f32 + offset.x, y as f32 + offset.y);
+                    let (ray, stream) = camera_sample(camera, pass.sampler, (x, y), pass.sample, pass.pixel_centre);
+                    ctx.stream = stream;
                     values.push(integrator.radiance(world, &ray, &mut ctx));
                 }
             }
