@@ -45,8 +45,8 @@ fn traversal(c: &mut Criterion) {
     });
     c.bench_function("256 shadow rays: shared-origin batch (incl. prepare)", |b| {
         b.iter(|| {
-            batch.prepare(world.bvh(), origin, &shaft);
-            black_box(rays.iter().filter(|r| batch.occluded(world.bvh(), r)).count())
+            world.prepare_batch(&mut batch, origin, &shaft);
+            black_box(rays.iter().filter(|r| world.occluded_in_batch(&batch, r)).count())
         })
     });
 }

@@ -3,7 +3,7 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::accel::{BuildPreset, Bvh4, Hit, Isa, OriginBatch, Region};
+use crate::accel::{Accel, BuildPreset, Hit, Isa, OriginBatch, Region};
 use crate::geometry::surface::SurfacePoint;
 use crate::lights::LightSet;
 use crate::materials::{Material, MaterialBsdf, MaterialKind};
@@ -14,8 +14,8 @@ use crate::textures::{TextureId, TextureSet};
 
 pub struct World {
     scene: Scene,
-    /// The 4-wide BVH; the binary tree it was collapsed from is dropped to save memory.
-    bvh: Bvh4,
+    /// The wide BVH of the ISA chosen; the binary tree it was collapsed from is dropped to save memory.
+    accel: Accel,
     lights: LightSet,
     /// Each material's kind, mapped once from its statements.
     kinds: Vec<MaterialKind>,
@@ -24,35 +24,34 @@ pub struct World {
     textures: TextureSet,
     /// What could not be derived (textures that failed to load), for the user to see.
     warnings: Vec<String>,
-    /// The instruction set, detected once here; the accel above was chosen from it.
-    isa: Isa,
 }
 
 impl World {
-    /// Builds the BVH over the scene's triangles, derives its lights and the kind of each material,
-    /// and decodes its textures.
+    /// Builds the BVH over the scene's triangles for the widest instruction set this CPU has,
+    /// derives its lights and the kind of each material, and decodes its textures.
     pub fn new(scene: Scene, preset: BuildPreset) -> World {
-        let isa = Isa::detect();
-        // The one place the accel is chosen by ISA. The 4-wide SSE kernel is the only one so far, and
-        // SSE is the x86-64 baseline (the portable kernel stands in elsewhere), so every ISA gets it.
-        let bvh = match isa {
-            Isa::Portable | Isa::Sse2 | Isa::Avx2 | Isa::Avx512 => {
-                Bvh4::build(&scene.mesh.positions, &scene.mesh.indices, preset)
-            }
-        };
+        World::with_isa(scene, preset, Isa::detect())
+    }
+
+    /// As [`World::new`], with the BVH of `isa` (every ISA gives the same image bytes).
+    ///
+    /// # Panics
+    /// If this CPU cannot run `isa` ([`Isa::is_supported`]).
+    pub fn with_isa(scene: Scene, preset: BuildPreset, isa: Isa) -> World {
+        let accel = Accel::build(&scene.mesh.positions, &scene.mesh.indices, preset, isa);
         let lights = LightSet::new(&scene);
         let kinds = scene.materials.iter().map(Material::kind).collect();
         let (texture_of_material, textures, warnings) =
             TextureSet::for_materials(scene.materials.iter().map(|m| m.map_kd.as_deref()));
-        World { scene, bvh, lights, kinds, texture_of_material, textures, warnings, isa }
+        World { scene, accel, lights, kinds, texture_of_material, textures, warnings }
     }
 
     pub fn scene(&self) -> &Scene {
         &self.scene
     }
 
-    pub fn bvh(&self) -> &Bvh4 {
-        &self.bvh
+    pub fn accel(&self) -> &Accel {
+        &self.accel
     }
 
     pub fn lights(&self) -> &LightSet {
@@ -76,9 +75,9 @@ impl World {
         self.kinds[id].bsdf(base)
     }
 
-    /// The instruction set detected when the world was built.
+    /// The instruction set the BVH was built for.
     pub fn isa(&self) -> Isa {
-        self.isa
+        self.accel.isa()
     }
 
     /// The material of triangle `id`.
@@ -99,25 +98,25 @@ impl World {
     /// The closest hit along `ray` within `[0, ray.tmax]`.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        self.bvh.intersect(ray)
+        self.accel.intersect(ray)
     }
 
     /// Whether anything lies along `ray` within `[0, ray.tmax]`.
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
-        self.bvh.occluded(ray)
+        self.accel.occluded(ray)
     }
 
     /// Readies `batch` for many rays leaving `origin` inside `region` (see [`OriginBatch`]).
     #[inline]
     pub fn prepare_batch(&self, batch: &mut OriginBatch, origin: Vec3, region: &Region) {
-        batch.prepare(&self.bvh, origin, region);
+        self.accel.prepare_batch(batch, origin, region);
     }
 
     /// [`World::occluded`] for a ray of a batch prepared with [`World::prepare_batch`].
     #[inline]
     pub fn occluded_in_batch(&self, batch: &OriginBatch, ray: &Ray) -> bool {
-        batch.occluded(&self.bvh, ray)
+        self.accel.occluded_in_batch(batch, ray)
     }
 
     /// The surface point of `hit`, found along `ray`.

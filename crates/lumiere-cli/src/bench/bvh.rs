@@ -7,7 +7,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use super::rays::{Query, RaySet};
-use lumiere::accel::{BuildPreset, Bvh, Bvh4, TraversalStats};
+use lumiere::accel::{Accel, BuildPreset, Bvh, Isa, TraversalStats};
 use lumiere::scene::mesh::TriangleMesh;
 
 /// Rays per rayon task: large enough to amortise scheduling, small enough to balance two cores.
@@ -26,11 +26,10 @@ pub fn median_seconds(repeats: usize, mut f: impl FnMut()) -> f64 {
     times[times.len() / 2]
 }
 
-/// Builds the renderer's BVH (binary SAH build, then collapse to 4-wide) on the current rayon pool.
-pub fn build(mesh: &TriangleMesh, preset: BuildPreset) -> (Bvh, Bvh4) {
-    let binary = Bvh::build(&mesh.positions, &mesh.indices, preset);
-    let wide = Bvh4::from_binary(&binary);
-    (binary, wide)
+/// Builds the renderer's BVH for `isa` (binary SAH build for its leaf width, then the collapse to
+/// its width) on the current rayon pool.
+pub fn build(mesh: &TriangleMesh, preset: BuildPreset, isa: Isa) -> Accel {
+    Accel::build(&mesh.positions, &mesh.indices, preset, isa)
 }
 
 /// Bytes of the mesh data the renderer keeps: positions, indices, material ids, normals, texcoords.
@@ -45,7 +44,7 @@ pub fn mesh_bytes(mesh: &TriangleMesh) -> usize {
 }
 
 /// Traces every ray of `set` once with the wide BVH on the current rayon pool.
-pub fn trace(bvh: &Bvh4, set: &RaySet) {
+pub fn trace(bvh: &Accel, set: &RaySet) {
     let found: u64 = match set.query {
         Query::Closest => set
             .rays
@@ -60,7 +59,7 @@ pub fn trace(bvh: &Bvh4, set: &RaySet) {
 }
 
 /// Average interior nodes and triangle blocks visited per ray.
-pub fn work_per_ray(bvh: &Bvh4, set: &RaySet) -> (f64, f64) {
+pub fn work_per_ray(bvh: &Accel, set: &RaySet) -> (f64, f64) {
     let mut stats = TraversalStats::default();
     for ray in &set.rays {
         match set.query {
@@ -73,7 +72,7 @@ pub fn work_per_ray(bvh: &Bvh4, set: &RaySet) -> (f64, f64) {
 }
 
 /// Rays whose wide-BVH answer differs from the scalar binary BVH's (must be 0).
-pub fn mismatches(binary: &Bvh, wide: &Bvh4, set: &RaySet) -> usize {
+pub fn mismatches(binary: &Bvh, wide: &Accel, set: &RaySet) -> usize {
     set.rays
         .par_iter()
         .filter(|r| match set.query {

@@ -2,6 +2,7 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use glam::Vec3;
+use lumiere::accel::Isa;
 use lumiere::render::aov::Aov;
 
 #[derive(Parser, Debug)]
@@ -50,6 +51,11 @@ pub struct BenchLabArgs {
     #[arg(long)]
     pub quick: bool,
 
+    /// SIMD kernels of the BVH: avx512, avx2, sse2 or portable (default: the widest this CPU
+    /// has, or $LUMIERE_ISA). Every ISA gives the same image bytes.
+    #[arg(long, value_parser = parse_isa)]
+    pub isa: Option<Isa>,
+
     /// Also write the table as JSON to this file.
     #[arg(long)]
     pub json: Option<PathBuf>,
@@ -68,6 +74,11 @@ pub struct BenchBvhArgs {
     /// Thread counts to measure, comma-separated.
     #[arg(long, value_delimiter = ',', default_value = "1,2")]
     pub threads: Vec<usize>,
+
+    /// SIMD kernels of the BVH: avx512, avx2, sse2 or portable (default: the widest this CPU
+    /// has, or $LUMIERE_ISA). Every ISA gives the same image bytes.
+    #[arg(long, value_parser = parse_isa)]
+    pub isa: Option<Isa>,
 
     /// Timed repetitions per measurement; the median is reported.
     #[arg(long, default_value_t = 5)]
@@ -201,6 +212,11 @@ pub struct RenderArgs {
     /// orbiter cameras use gKit's 45. [default: 45]
     #[arg(long, value_parser = parse_fov, allow_hyphen_values = true)]
     pub fov: Option<f32>,
+
+    /// SIMD kernels of the BVH: avx512, avx2, sse2 or portable (default: the widest this CPU
+    /// has, or $LUMIERE_ISA). Every ISA gives the same image bytes.
+    #[arg(long, value_parser = parse_isa)]
+    pub isa: Option<Isa>,
 
     /// Worker threads, at most 1024; 0 = one per core, 1 = serial.
     #[arg(long, default_value_t = 0, value_parser = parse_threads)]
@@ -338,6 +354,10 @@ const MAX_THREADS: usize = 1024;
 fn parse_threads(s: &str) -> Result<usize, String> {
     let value: usize = s.trim().parse().map_err(|_| format!("expected a thread count, got {s:?}"))?;
     if value <= MAX_THREADS { Ok(value) } else { Err(format!("at most {MAX_THREADS} threads, got {value}")) }
+}
+
+fn parse_isa(s: &str) -> Result<Isa, String> {
+    super::isa::parse(s)
 }
 
 fn parse_emission(s: &str) -> Result<(String, Vec3), String> {

@@ -16,6 +16,7 @@ use super::output;
 use super::pool;
 
 pub fn run(args: &BenchBvhArgs) -> Result<()> {
+    let isa = super::isa::choose(args.isa)?;
     let scenes: Vec<BenchScene> = args
         .scenes
         .split(',')
@@ -40,34 +41,36 @@ pub fn run(args: &BenchBvhArgs) -> Result<()> {
 
         // Reference structures and ray sets, built once.
         let binary = Bvh::build(&scene.mesh.positions, &scene.mesh.indices, BuildPreset::Default);
-        let costs: Vec<String> =
-            BuildPreset::ALL.iter().map(|&p| format!("{:.1}", build(&scene.mesh, p).0.sah_cost())).collect();
-        let world = World::new(scene, BuildPreset::Default);
+        let costs: Vec<String> = BuildPreset::ALL
+            .iter()
+            .map(|&p| format!("{:.1}", Bvh::build(&scene.mesh.positions, &scene.mesh.indices, p).sah_cost()))
+            .collect();
+        let world = World::with_isa(scene, BuildPreset::Default, isa);
         let sets = make_ray_sets(&world, &camera, args.seed);
-        let bytes = mesh + world.bvh().memory_bytes();
+        let bytes = mesh + world.accel().memory_bytes();
         for &n in &threads {
             let pool = pool(n)?;
             let build_ms = 1e3
                 * pool.install(|| {
-                    median_seconds(args.repeats, || drop(build(&world.scene().mesh, BuildPreset::Default)))
+                    median_seconds(args.repeats, || drop(build(&world.scene().mesh, BuildPreset::Default, world.isa())))
                 });
             builds.push(format!(
                 "| {} | {} | {triangles} | {load_ms:.0} | {build_ms:.0} | {} / {} | {} | {:.1} | {:.0} |",
                 bench.name,
                 n,
                 binary.nodes().len(),
-                world.bvh().nodes().len(),
+                world.accel().node_count(),
                 costs.join(" / "),
                 bytes as f64 / triangles as f64,
                 peak_rss_mib().unwrap_or(f64::NAN),
             ));
-            json.push(serde_json::json!({"scene": bench.name, "threads": n, "what": "build", "triangles": triangles, "load_ms": load_ms, "build_ms": build_ms, "binary_nodes": binary.nodes().len(), "wide_nodes": world.bvh().nodes().len(), "bytes_per_triangle": bytes as f64 / triangles as f64}));
+            json.push(serde_json::json!({"scene": bench.name, "threads": n, "what": "build", "triangles": triangles, "load_ms": load_ms, "build_ms": build_ms, "binary_nodes": binary.nodes().len(), "wide_nodes": world.accel().node_count(), "bytes_per_triangle": bytes as f64 / triangles as f64}));
         }
         for set in &sets {
-            let wrong = mismatches(&binary, world.bvh(), set);
-            let (nodes, blocks) = work_per_ray(world.bvh(), set);
+            let wrong = mismatches(&binary, world.accel(), set);
+            let (nodes, blocks) = work_per_ray(world.accel(), set);
             for &n in &threads {
-                let seconds = pool(n)?.install(|| median_seconds(args.repeats, || trace(world.bvh(), set)));
+                let seconds = pool(n)?.install(|| median_seconds(args.repeats, || trace(world.accel(), set)));
                 let mrays = set.rays.len() as f64 / seconds / 1e6;
                 traces.push(format!(
                     "| {} | {} {} | {} | {} | {:.1} | {mrays:.1} | {nodes:.1} | {blocks:.1} | {wrong} |",

@@ -70,7 +70,7 @@ const LAB_ROWS: [LabRow; 7] = [
 pub fn run(args: &BenchLabArgs) -> Result<()> {
     let (width, height, repeats) =
         if args.quick { (256, 192, 1) } else { (builtin::WIDTH, builtin::HEIGHT, args.repeats) };
-    let world = World::new(Scene::builtin()?, Default::default());
+    let world = World::with_isa(Scene::builtin()?, Default::default(), super::isa::choose(args.isa)?);
     let camera = Camera::from_orbiter(&builtin::cornell_orbiter()?, width, height);
     let all_cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let serial = pool(1)?;

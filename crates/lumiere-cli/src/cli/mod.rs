@@ -6,6 +6,7 @@ mod bench_lab;
 mod bench_sampler;
 mod export;
 mod info;
+mod isa;
 pub mod output;
 mod render;
 

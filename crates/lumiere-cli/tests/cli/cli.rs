@@ -175,6 +175,7 @@ fn stats_json_has_the_promised_fields() {
         assert!(json.get(key).is_some(), "missing {key} in {json}");
     }
     assert_eq!(json["mode"], "hits");
+    assert_eq!(json["isa"], lumiere::accel::Isa::detect().name(), "the widest ISA by default");
     assert_eq!(json["triangles"], 32);
     assert_eq!(json["rays"], 32 * 24);
     assert!(stderr(&run).contains("Mrays/s"), "closing line: {}", stderr(&run));
@@ -244,6 +245,10 @@ fn bad_inputs_give_a_clear_error_and_no_file() {
     assert_refused(&dir, &["render", "--samples", "0"], "samples");
     assert_refused(&dir, &["render", "--mode", "teapot"], "teapot");
     assert_refused(&dir, &["render", "--eye", "0,0,nan", "--target", "0,0,1"], "finite");
+    assert_refused(&dir, &["render", "--isa", "mmx"], "unknown ISA \"mmx\" (expected portable, sse2, avx2, avx512)");
+    if let Some(missing) = lumiere::accel::Isa::ALL.into_iter().find(|isa| !isa.is_supported()) {
+        assert_refused(&dir, &["render", "--isa", missing.name()], "this CPU cannot run");
+    }
 
     let unreadable_orbiter = dir.path("no_such_orbiter.txt");
     assert_refused(&dir, &["render", "--orbiter", unreadable_orbiter.to_str().unwrap()], "no_such_orbiter.txt");
@@ -256,6 +261,32 @@ fn bad_inputs_give_a_clear_error_and_no_file() {
         assert!(!Path::new(path).exists());
     }
     assert_eq!(dir.entries(), ["bad_number.obj", "inf.obj", "nan.obj", "range.obj"]);
+}
+
+/// `$LUMIERE_ISA` forces the ISA when `--isa` is absent, and is checked like the flag.
+#[test]
+fn isa_environment_variable_is_honoured_and_checked() {
+    let dir = TempDir::new("isa-env");
+    let (out, stats) = (dir.path("r.png"), dir.path("s.json"));
+    let run = |value: &str, extra: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_lumiere"))
+            .args(["render", "--mode", "hits", "--size", "16x12", "-o", out.to_str().unwrap()])
+            .args(["--stats-json", stats.to_str().unwrap()])
+            .args(extra)
+            .env("LUMIERE_ISA", value)
+            .output()
+            .unwrap()
+    };
+    let isa_used = || serde_json::from_slice::<serde_json::Value>(&fs::read(&stats).unwrap()).unwrap()["isa"].clone();
+    assert!(run("sse2", &[]).status.success());
+    assert_eq!(isa_used(), "sse2");
+    assert!(run("sse2", &["--isa", "portable"]).status.success(), "the flag wins");
+    assert_eq!(isa_used(), "portable");
+    let _ = fs::remove_file(&out);
+    let refused = run("avx9000", &[]);
+    assert_eq!(refused.status.code(), Some(2));
+    assert!(stderr(&refused).contains("LUMIERE_ISA: unknown ISA"), "{}", stderr(&refused));
+    assert!(!out.exists());
 }
 
 #[test]

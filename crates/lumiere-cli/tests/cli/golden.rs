@@ -11,6 +11,8 @@
 
 use std::process::Command;
 
+use lumiere::accel::Isa;
+
 /// FNV-1a, 64 bits: a fixed, dependency-free digest of a file's bytes.
 fn fnv1a(bytes: &[u8]) -> u64 {
     bytes.iter().fold(0xCBF2_9CE4_8422_2325, |h, &b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01B3))
@@ -18,12 +20,19 @@ fn fnv1a(bytes: &[u8]) -> u64 {
 
 /// Renders the built-in scene at 64x48 with `args` to `.pfm` and `.png`; returns both files' hashes.
 fn hashes(name: &str, args: &[&str]) -> (u64, u64) {
+    hashes_of(name, &["--size", "64x48"], args)
+}
+
+/// Renders with `scene_args` (a size, perhaps a scene file) and `args` to `.pfm` and `.png`;
+/// returns both files' hashes.
+fn hashes_of(name: &str, scene_args: &[&str], args: &[&str]) -> (u64, u64) {
     let dir = std::env::temp_dir().join(format!("lumiere-golden-{name}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let digest = |extension: &str| {
         let out = dir.join(format!("{name}.{extension}"));
         let status = Command::new(env!("CARGO_BIN_EXE_lumiere"))
-            .args(["render", "--size", "64x48"])
+            .arg("render")
+            .args(scene_args)
             .args(args)
             .arg("-o")
             .arg(&out)
@@ -38,9 +47,11 @@ fn hashes(name: &str, args: &[&str]) -> (u64, u64) {
     result
 }
 
-#[test]
-fn every_mode_renders_the_bytes_recorded_before_the_reshape() {
-    let cases: [(&str, &[&str], u64, u64); 8] = [
+/// Each mode's arguments and the hashes of its `.pfm` and `.png`.
+type Case = (&'static str, &'static [&'static str], u64, u64);
+
+#[rustfmt::skip]
+const CASES: [Case; 8] = [
         ("hits", &["--mode", "hits"], 0xe5be6fadb7d0387a, 0x7d3cdc4ae8c8cc5c),
         ("materials", &["--mode", "materials"], 0xdadcc58aa85add45, 0x03b4ff564eb04fcc),
         ("shadows", &["--mode", "shadows"], 0x76e28bae8e2de7eb, 0x723af1f9843debe7),
@@ -60,12 +71,80 @@ fn every_mode_renders_the_bytes_recorded_before_the_reshape() {
         ),
         ("path", &["--mode", "path", "--spp", "2", "--max-depth", "5"], 0xdd103c261bce61f9, 0x96e76b52e6c30b2f),
     ];
+
+/// The renders of `CASES` whose bytes differ from the recorded ones, each with `extra` arguments.
+fn failures_with(extra: &[&str]) -> Vec<String> {
     let mut failures = Vec::new();
-    for (name, args, pfm, png) in cases {
-        let got = hashes(name, args);
+    for (name, args, pfm, png) in CASES {
+        let args: Vec<&str> = args.iter().chain(extra).copied().collect();
+        let got = hashes(name, &args);
         if got != (pfm, png) {
-            failures.push(format!("{name}: pfm {:#018x} png {:#018x}, expected {pfm:#018x} {png:#018x}", got.0, got.1));
+            failures.push(format!(
+                "{name} {extra:?}: pfm {:#018x} png {:#018x}, expected {pfm:#018x} {png:#018x}",
+                got.0, got.1
+            ));
         }
     }
+    failures
+}
+
+#[test]
+fn every_mode_renders_the_bytes_recorded_before_the_reshape() {
+    let failures = failures_with(&[]);
     assert!(failures.is_empty(), "image bytes changed:\n{}", failures.join("\n"));
+}
+
+/// The same bytes with the BVH and kernels of every ISA this CPU runs (4-wide portable and SSE,
+/// 8-wide AVX2 and AVX-512): the kernels round exactly like the scalar test, so the ISA changes
+/// speed, never an image.
+#[test]
+fn every_isa_renders_the_recorded_bytes() {
+    let isas = Isa::supported();
+    println!("ISAs on this CPU: {isas:?}");
+    let failures: Vec<String> = isas.iter().flat_map(|isa| failures_with(&["--isa", isa.name()])).collect();
+    assert!(failures.is_empty(), "image bytes differ between ISAs:\n{}", failures.join("\n"));
+}
+
+/// Real meshes, whose 8-wide trees have many levels (the built-in box fits in one node): every
+/// mode that traces rays gives the same bytes on every ISA.
+#[test]
+fn every_isa_renders_the_same_bytes_of_real_scenes() {
+    let (Some(bunny), Some(staircase)) = (
+        crate::common::shared_scene("bunny/stanford-bunny.obj"),
+        crate::common::shared_scene("staircase/staircase.obj.gz"),
+    ) else {
+        return;
+    };
+    let (bunny, staircase) = (bunny.to_str().unwrap(), staircase.to_str().unwrap());
+    let staircase_camera = [
+        "--eye",
+        "0.0324209,1.52673,4.88197",
+        "--target",
+        "0.0247749,1.571785,3.883015",
+        "--fov",
+        "58.54",
+        "--emission",
+        "Emission=5,5,5",
+    ];
+    let renders: [(&str, Vec<&str>); 4] = [
+        ("bunny-hits", vec![bunny, "--size", "96x72", "--mode", "hits"]),
+        ("bunny-ao", vec![bunny, "--size", "96x72", "--mode", "ao", "--samples", "4"]),
+        (
+            "staircase-direct",
+            [
+                &[staircase, "--size", "36x64", "--mode", "direct", "--light-sampling", "power", "--samples", "2"][..],
+                &staircase_camera,
+            ]
+            .concat(),
+        ),
+        (
+            "staircase-path",
+            [&[staircase, "--size", "36x64", "--mode", "path", "--spp", "2"][..], &staircase_camera].concat(),
+        ),
+    ];
+    for (name, args) in renders {
+        let per_isa: Vec<(Isa, (u64, u64))> =
+            Isa::supported().into_iter().map(|isa| (isa, hashes_of(name, &args, &["--isa", isa.name()]))).collect();
+        assert!(per_isa.windows(2).all(|w| w[0].1 == w[1].1), "{name}: bytes differ between ISAs: {per_isa:x?}");
+    }
 }

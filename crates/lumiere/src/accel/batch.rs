@@ -84,22 +84,20 @@ impl Region {
     }
 
     /// Mask of the block's `W` triangles that do not lie wholly at or below `keep_above` of a plane.
+    #[inline(always)]
     fn keeps_triangles<const W: usize, L: Lanes<W>>(&self, vertices: &[[[f32; W]; 3]; 3]) -> u32 {
         let mut kept = const { all_lanes(W) };
         for (plane, &keep_above) in self.planes[..self.count].iter().zip(&self.keep_above) {
-            let distance = |corner: &[[f32; W]; 3]| {
-                L::load(&corner[0]) * L::splat(plane.x)
-                    + L::load(&corner[1]) * L::splat(plane.y)
-                    + L::load(&corner[2]) * L::splat(plane.z)
-                    + L::splat(plane.w)
-            };
-            let highest = distance(&vertices[0]).max(distance(&vertices[1])).max(distance(&vertices[2]));
+            let highest = plane_distance::<W, L>(plane, &vertices[0])
+                .max(plane_distance(plane, &vertices[1]))
+                .max(plane_distance(plane, &vertices[2]));
             kept &= highest.gt(L::splat(keep_above)).bits();
         }
         kept
     }
 
     /// Mask of the node's `W` child boxes that reach above `keep_above` on every plane.
+    #[inline(always)]
     fn contains_box<const W: usize, L: Lanes<W>>(&self, node_bounds: &[[f32; W]; 6]) -> u32 {
         let mut inside = const { all_lanes(W) };
         for (plane, &keep_above) in self.planes[..self.count].iter().zip(&self.keep_above) {
@@ -113,6 +111,16 @@ impl Region {
         }
         inside
     }
+}
+
+/// Signed distances (times the normal's length) of `W` points, SoA, above `plane`. A function
+/// rather than a closure, so that it is inlined into the kernel's `#[target_feature]` code.
+#[inline(always)]
+fn plane_distance<const W: usize, L: Lanes<W>>(plane: &Vec4, points: &[[f32; W]; 3]) -> L {
+    L::load(&points[0]) * L::splat(plane.x)
+        + L::load(&points[1]) * L::splat(plane.y)
+        + L::load(&points[2]) * L::splat(plane.z)
+        + L::splat(plane.w)
 }
 
 /// A few thousand ulps of the region's coordinates: far above rounding, far below any geometry.
@@ -134,6 +142,14 @@ impl OriginBatch {
     /// line, one copy per BVH type and crate (see the note in `wide/traverse.rs`).
     #[inline(never)]
     pub fn prepare<const W: usize, L: Lanes<W>>(&mut self, bvh: &WideBvh<W, L>, origin: Vec3, region: &Region) {
+        L::dispatch(
+            #[inline(always)]
+            || self.gather(bvh, origin, region),
+        );
+    }
+
+    #[inline(always)]
+    fn gather<const W: usize, L: Lanes<W>>(&mut self, bvh: &WideBvh<W, L>, origin: Vec3, region: &Region) {
         self.origin = origin;
         self.blocks.clear();
         self.traverse = false;

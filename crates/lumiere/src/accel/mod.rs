@@ -7,20 +7,23 @@
 //!   collapsed from the binary tree, traversed with a SIMD lane kernel.
 //! - `simd/`: the lane trait, its kernels, and [`Isa::detect`].
 //! - `batch.rs`: shared-origin ray batches (shadow rays to one light triangle, AO hemispheres).
+//! - `dispatch.rs`: [`Accel`], the wide BVH of the [`Isa`] a render runs with.
 
 mod batch;
 mod bvh2;
+mod dispatch;
 pub mod simd;
 mod slab;
 mod wide;
 
 pub use batch::{OriginBatch, Region};
 pub use bvh2::{BuildPreset, Bvh, Node};
+pub use dispatch::Accel;
 pub use simd::Isa;
 pub use wide::{TriangleBlock, WideBvh, WideNode};
 
-/// The layout and kernel rendered today: 4 wide, SSE (the x86-64 baseline; the portable kernel
-/// elsewhere). `World::new` picks it for every [`Isa`] until a wider kernel exists.
+/// The 4-wide layout with the SSE kernel (the x86-64 baseline; the portable kernel elsewhere):
+/// [`Accel`]'s choice for [`Isa::Sse2`].
 pub type Bvh4 = WideBvh<4, simd::F32x4>;
 
 /// The closest intersection along a ray.

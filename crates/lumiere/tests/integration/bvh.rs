@@ -4,7 +4,7 @@
 use crate::common::{TestRng, grid_cube};
 use glam::Vec3;
 use lumiere::accel::simd::portable::F32xN;
-use lumiere::accel::{BuildPreset, Bvh, Bvh4, Hit, TraversalStats, WideBvh};
+use lumiere::accel::{Accel, BuildPreset, Bvh, Bvh4, Hit, Isa, TraversalStats, WideBvh};
 use lumiere::geometry::triangle::{WatertightRay, intersect_triangle, is_degenerate};
 use lumiere::math::Ray;
 
@@ -66,8 +66,9 @@ type PortableBvh4 = WideBvh<4, F32xN<4>>;
 type PortableBvh8 = WideBvh<8, F32xN<8>>;
 
 /// Every preset and every traversal path (binary scalar, 4-wide SIMD, counted variants, the
-/// portable kernel at widths 4 and 8) must give brute force's answer bit for bit: same triangle,
-/// same t and barycentrics, same occlusion.
+/// portable kernel at widths 4 and 8, and the accel of every ISA this CPU runs: 8-wide AVX2 and
+/// AVX-512 where present) must give brute force's answer bit for bit: same triangle, same t and
+/// barycentrics, same occlusion.
 fn check_against_brute_force(positions: &[Vec3], indices: &[[u32; 3]], rays: &[Ray], context: &str) {
     for preset in BuildPreset::ALL {
         let bvh = Bvh::build(positions, indices, preset);
@@ -77,6 +78,8 @@ fn check_against_brute_force(positions: &[Vec3], indices: &[[u32; 3]], rays: &[R
         let bvh8 = Bvh::build_for_width::<8>(positions, indices, preset);
         bvh8.validate().unwrap_or_else(|e| panic!("{context} {preset:?} for width 8: {e}"));
         let wide8 = PortableBvh8::from_binary(&bvh8);
+        let accels: Vec<Accel> =
+            Isa::supported().into_iter().map(|isa| Accel::build(positions, indices, preset, isa)).collect();
         let mut stats = TraversalStats::default();
         for ray in rays {
             let expected = brute_force(positions, indices, ray);
@@ -90,6 +93,13 @@ fn check_against_brute_force(positions: &[Vec3], indices: &[[u32; 3]], rays: &[R
             for (path, hit, occluded) in paths {
                 assert_eq!(hit, expected, "{context} {preset:?} {path} {ray:?}");
                 assert_eq!(occluded, expected.is_some(), "{context} {preset:?} {path} occlusion {ray:?}");
+            }
+            for accel in &accels {
+                let isa = accel.isa();
+                assert_eq!(accel.intersect(ray), expected, "{context} {preset:?} {isa} {ray:?}");
+                assert_eq!(accel.intersect_counted(ray, &mut stats), expected, "{context} {preset:?} {isa} counted");
+                assert_eq!(accel.occluded(ray), expected.is_some(), "{context} {preset:?} {isa} occlusion {ray:?}");
+                assert_eq!(accel.occluded_counted(ray, &mut stats), expected.is_some(), "{context} {isa} counted");
             }
         }
         assert!(rays.is_empty() || indices.is_empty() || stats.nodes > 0, "{context}: counters count");
@@ -137,6 +147,13 @@ fn closed_mesh_rays_through_vertices_and_edges_never_leak() {
             assert!(bvh.intersect(ray).is_some() && wide.intersect(ray).is_some(), "{preset:?}: {ray:?} escaped");
             assert!(bvh.occluded(ray) && wide.occluded(ray), "{preset:?}: {ray:?} escaped");
         }
+        for isa in Isa::supported() {
+            let accel = Accel::build(&positions, &indices, preset, isa);
+            assert!(
+                rays.iter().all(|r| accel.intersect(r).is_some() && accel.occluded(r)),
+                "{preset:?} {isa}: a ray escaped"
+            );
+        }
     }
     check_against_brute_force(&positions, &indices, &rays, "grid cube");
 }
@@ -163,6 +180,10 @@ fn origin_batches_agree_with_traversal() {
         let wide = Bvh4::from_binary(&Bvh::build(&positions, &indices, BuildPreset::Default));
         let wide8 = PortableBvh8::build(&positions, &indices, BuildPreset::Default);
         let (mut batch, mut batch8) = (OriginBatch::default(), OriginBatch::default());
+        let mut accels: Vec<(Accel, OriginBatch)> = Isa::supported()
+            .into_iter()
+            .map(|isa| (Accel::build(&positions, &indices, BuildPreset::Default, isa), OriginBatch::default()))
+            .collect();
         for _ in 0..8 {
             let origin = rng.vec3(-12.0, 12.0);
             let corners = [rng.vec3(-12.0, 12.0), rng.vec3(-12.0, 12.0), rng.vec3(-12.0, 12.0)];
@@ -177,6 +198,10 @@ fn origin_batches_agree_with_traversal() {
             // walk must gather the same ones (possibly packed in another order).
             batch8.prepare(&wide8, origin, &region);
             assert_eq!(batch8.candidate_blocks(), batch.candidate_blocks(), "mesh {mesh_index}");
+            for (accel, accel_batch) in &mut accels {
+                accel.prepare_batch(accel_batch, origin, &region);
+                assert_eq!(accel_batch.candidate_blocks(), batch.candidate_blocks(), "mesh {mesh_index}");
+            }
             for _ in 0..64 {
                 let ray = if shaft {
                     let (a, b) = (rng.f32(), rng.f32());
@@ -191,6 +216,10 @@ fn origin_batches_agree_with_traversal() {
                 let occluded = batch.occluded(&wide, &ray);
                 differ += usize::from(occluded != wide.occluded(&ray));
                 assert_eq!(batch8.occluded(&wide8, &ray), occluded, "mesh {mesh_index}: 8-wide batch {ray:?}");
+                for (accel, accel_batch) in &accels {
+                    let isa = accel.isa();
+                    assert_eq!(accel.occluded_in_batch(accel_batch, &ray), occluded, "mesh {mesh_index}: {isa} batch");
+                }
             }
         }
     }

@@ -46,6 +46,7 @@ fn render(args: &RenderArgs, threads: usize, denoiser: Option<&oidn::Oidn>) -> R
     for ignored in options::ignored_flags(args) {
         output::warn(ignored);
     }
+    let isa = super::isa::choose(args.isa)?;
     let load_start = Instant::now();
     let scene = load_scene(args)?;
     let load_ms = load_start.elapsed().as_secs_f64() * 1e3;
@@ -56,7 +57,7 @@ fn render(args: &RenderArgs, threads: usize, denoiser: Option<&oidn::Oidn>) -> R
     let (film, stats) = fingerprints.start(args.resume.as_deref(), &camera)?;
 
     let build_start = Instant::now();
-    let world = World::new(scene, BuildPreset::Default);
+    let world = World::with_isa(scene, BuildPreset::Default, isa);
     for warning in world.warnings() {
         output::warn(warning);
     }

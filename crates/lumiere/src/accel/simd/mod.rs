@@ -2,16 +2,19 @@
 //! detected.
 //!
 //! The wide traversal and the batches are written once against [`Lanes`]; a kernel is a type
-//! implementing it for one width. Today there are two: [`sse::F32x4`] (four lanes, SSE, part of the
-//! x86-64 baseline, so it needs no runtime detection) and [`portable::F32xN`] (plain arrays, any
-//! width: the fallback on other architectures, and a second implementation the tests check the SSE
-//! one against). An AVX2 or AVX-512 kernel is one more type implementing `Lanes<8>` or `Lanes<16>`,
-//! entered through a `#[target_feature]` function whose SAFETY line names [`Isa::detect`], plus one
-//! more arm where `World::new` picks the accel from the detected [`Isa`].
+//! implementing it for one width:
+//! - [`sse::F32x4`]: four lanes, SSE, part of the x86-64 baseline, so it needs no detection;
+//! - `avx::F32x8<Avx2>` and `avx::F32x8<Avx512>`: eight lanes, entered through
+//!   [`Lanes::dispatch`], which runs the traversal inside a `#[target_feature]` function; they exist
+//!   only inside an [`crate::accel::Accel`] built after checking [`Lanes::supported`];
+//! - [`portable::F32xN`]: plain arrays of any width, the fallback on other architectures and a
+//!   second implementation the tests check the others against.
 //!
 //! Kernels must not contract multiplies and adds into FMAs (Rust never does so implicitly): the wide
-//! triangle test must round exactly like the scalar one.
+//! triangle test must round exactly like the scalar one, so every ISA gives the same image bytes.
 
+#[cfg(target_arch = "x86_64")]
+pub(crate) mod avx;
 mod isa;
 pub mod portable;
 #[cfg(target_arch = "x86_64")]
@@ -38,6 +41,19 @@ pub trait Lanes<const W: usize>:
 {
     /// One boolean per lane, as comparisons return it.
     type Mask: LaneMask;
+
+    /// Whether this CPU can run the kernel. Kernels outside the x86-64 baseline must not be used
+    /// (not even built into a BVH) where this is false.
+    fn supported() -> bool {
+        true
+    }
+
+    /// Runs `f`, the traversal written against this kernel, with the kernel's instruction set
+    /// enabled. Every entry point of the wide BVH goes through it.
+    #[inline(always)]
+    fn dispatch<R>(f: impl FnOnce() -> R) -> R {
+        f()
+    }
 
     fn splat(v: f32) -> Self;
     fn load(a: &[f32; W]) -> Self;

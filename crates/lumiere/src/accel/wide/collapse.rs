@@ -6,14 +6,18 @@ use std::marker::PhantomData;
 use super::node::{TriangleBlock, WideNode};
 use super::{WideBvh, leaf};
 use crate::accel::bvh2::{Bvh, Node};
+use crate::accel::simd::Lanes;
 
-impl<const W: usize, L> WideBvh<W, L> {
+impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
     /// Collapses a binary BVH. Any binary tree will do; one built for blocks of `W` triangles
     /// (`Bvh::build_for_width::<W>`) has the leaves this layout packs best.
     pub fn from_binary(bvh: &Bvh) -> Self {
         // The byte budgets of this width, checked at compile time.
         let () = WideNode::<W>::BYTE_BUDGET;
         let () = TriangleBlock::<W>::BYTE_BUDGET;
+        // A BVH is the only way into a kernel's code (`Lanes::dispatch`): never build one for a
+        // kernel this CPU cannot run.
+        assert!(L::supported(), "this CPU cannot run the kernel of a {W}-wide BVH");
 
         let mut wide = WideBvh {
             nodes: Vec::new(),

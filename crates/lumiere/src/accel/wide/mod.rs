@@ -3,9 +3,9 @@
 //! triangles in SoA layout, tested together too.
 //!
 //! The layout (nodes, blocks, collapse, leaf references) is generic in the width `W`; the traversal
-//! is generic over the lane kernel `L` (see `simd/`). The renderer instantiates `W = 4` with the SSE
-//! kernel ([`crate::accel::Bvh4`]): SSE is part of the x86-64 baseline, so the binary runs on every
-//! x86-64 CPU; eight lanes need AVX2, a kernel that does not exist yet.
+//! is generic over the lane kernel `L` (see `simd/`). [`crate::accel::Accel`] instantiates `W = 4`
+//! with the SSE kernel (the x86-64 baseline) or the portable one, and `W = 8` with the AVX2 and
+//! AVX-512 kernels.
 
 mod collapse;
 mod leaf;
@@ -38,7 +38,10 @@ impl<const W: usize, L> WideBvh<W, L> {
     pub const WIDTH: usize = W;
 
     /// Builds the binary SAH tree for blocks of `W` triangles and collapses it.
-    pub fn build(positions: &[Vec3], indices: &[[u32; 3]], preset: BuildPreset) -> Self {
+    pub fn build(positions: &[Vec3], indices: &[[u32; 3]], preset: BuildPreset) -> Self
+    where
+        L: crate::accel::simd::Lanes<W>,
+    {
         Self::from_binary(&Bvh::build_for_width::<W>(positions, indices, preset))
     }
 

@@ -87,33 +87,47 @@ impl<L> BoxRay<L> {
     }
 }
 
-// The entry points stay out of line, one copy per kernel and crate, like the non-generic 4-wide
-// functions they replaced: a generic function may otherwise be inlined at each call site, which
-// would change the code the renders and benchmarks were measured with.
+// The entry points stay out of line, one copy per kernel and crate: a generic function may otherwise
+// be inlined at each call site, which would change the code the renders and benchmarks were
+// measured with. Each enters its kernel's instruction set through `Lanes::dispatch`, with the
+// traversal in an `#[inline(always)]` closure: only code inlined into the `#[target_feature]`
+// function gets the kernel's instructions (anywhere else its intrinsics become calls).
 impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
     /// The closest hit with `t` in `(0, ray.tmax]`, ties to the lower triangle id; identical to
     /// [`crate::accel::Bvh::intersect`].
     #[inline(never)]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        self.intersect_impl::<false>(ray, &mut TraversalStats::default())
+        L::dispatch(
+            #[inline(always)]
+            || self.intersect_impl::<false>(ray, &mut TraversalStats::default()),
+        )
     }
 
     /// As [`WideBvh::intersect`], counting nodes and blocks visited into `stats`.
     #[inline(never)]
     pub fn intersect_counted(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
-        self.intersect_impl::<true>(ray, stats)
+        L::dispatch(
+            #[inline(always)]
+            || self.intersect_impl::<true>(ray, stats),
+        )
     }
 
     /// True if anything lies on the ray with `t` in `(0, ray.tmax]`.
     #[inline(never)]
     pub fn occluded(&self, ray: &Ray) -> bool {
-        self.occluded_impl::<false>(ray, &mut TraversalStats::default())
+        L::dispatch(
+            #[inline(always)]
+            || self.occluded_impl::<false>(ray, &mut TraversalStats::default()),
+        )
     }
 
     /// As [`WideBvh::occluded`], counting nodes and blocks visited into `stats`.
     #[inline(never)]
     pub fn occluded_counted(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
-        self.occluded_impl::<true>(ray, stats)
+        L::dispatch(
+            #[inline(always)]
+            || self.occluded_impl::<true>(ray, stats),
+        )
     }
 
     #[inline(always)]

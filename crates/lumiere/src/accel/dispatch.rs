@@ -1,0 +1,131 @@
+//! The accel a render uses: the wide BVH of one [`Isa`], chosen once, with one entry point per
+//! query that forwards to that BVH's monomorphised traversal.
+//!
+//! Every ISA returns the same hits bit for bit (the kernels perform the scalar test's operations in
+//! the same order, and ties go to the lower triangle id whatever the tree), so the choice changes
+//! speed and never an image.
+
+use glam::Vec3;
+
+use super::bvh2::{BuildPreset, Bvh};
+use super::simd::portable::F32xN;
+use super::wide::WideBvh;
+use super::{Bvh4, Hit, Isa, OriginBatch, Region, TraversalStats};
+use crate::math::Ray;
+
+/// A BVH built for one instruction set.
+#[derive(Clone, Debug)]
+pub struct Accel {
+    bvh: IsaBvh,
+    isa: Isa,
+}
+
+/// The layout and kernel of each ISA. The AVX kernels' types are private to `accel`, which keeps
+/// them out of reach of code that has not checked [`Isa::is_supported`].
+#[derive(Clone, Debug)]
+enum IsaBvh {
+    Portable(WideBvh<4, F32xN<4>>),
+    Sse2(Bvh4),
+    #[cfg(target_arch = "x86_64")]
+    Avx2(WideBvh<8, super::simd::avx::F32x8<super::simd::avx::Avx2>>),
+    #[cfg(target_arch = "x86_64")]
+    Avx512(WideBvh<8, super::simd::avx::F32x8<super::simd::avx::Avx512>>),
+}
+
+/// Evaluates `$body` with `$bvh` bound to the accel's BVH, whatever its type.
+macro_rules! with_bvh {
+    ($accel:expr, $bvh:ident => $body:expr) => {
+        match &$accel.bvh {
+            IsaBvh::Portable($bvh) => $body,
+            IsaBvh::Sse2($bvh) => $body,
+            #[cfg(target_arch = "x86_64")]
+            IsaBvh::Avx2($bvh) => $body,
+            #[cfg(target_arch = "x86_64")]
+            IsaBvh::Avx512($bvh) => $body,
+        }
+    };
+}
+
+impl Accel {
+    /// Builds the binary SAH tree for `isa`'s leaf width and collapses it to `isa`'s layout.
+    ///
+    /// # Panics
+    /// If this CPU cannot run `isa` ([`Isa::is_supported`]): callers check user input first.
+    pub fn build(positions: &[Vec3], indices: &[[u32; 3]], preset: BuildPreset, isa: Isa) -> Accel {
+        let binary = match isa.width() {
+            4 => Bvh::build_for_width::<4>(positions, indices, preset),
+            _ => Bvh::build_for_width::<8>(positions, indices, preset),
+        };
+        Accel::from_binary(&binary, isa)
+    }
+
+    /// Collapses a binary BVH (any; one built for `isa.width()` packs best) to `isa`'s layout.
+    ///
+    /// # Panics
+    /// If this CPU cannot run `isa`.
+    pub fn from_binary(binary: &Bvh, isa: Isa) -> Accel {
+        assert!(isa.is_supported(), "this CPU cannot run the {isa} kernels");
+        let bvh = match isa {
+            Isa::Portable => IsaBvh::Portable(WideBvh::from_binary(binary)),
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx2 => IsaBvh::Avx2(WideBvh::from_binary(binary)),
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx512 => IsaBvh::Avx512(WideBvh::from_binary(binary)),
+            _ => IsaBvh::Sse2(WideBvh::from_binary(binary)),
+        };
+        Accel { bvh, isa }
+    }
+
+    pub fn isa(&self) -> Isa {
+        self.isa
+    }
+
+    /// Children per node and triangles per leaf block.
+    pub fn width(&self) -> usize {
+        self.isa.width()
+    }
+
+    pub fn node_count(&self) -> usize {
+        with_bvh!(self, bvh => bvh.nodes().len())
+    }
+
+    /// Bytes held by the nodes and the triangle blocks.
+    pub fn memory_bytes(&self) -> usize {
+        with_bvh!(self, bvh => bvh.memory_bytes())
+    }
+
+    /// The closest hit with `t` in `(0, ray.tmax]`, ties to the lower triangle id; identical to
+    /// [`Bvh::intersect`].
+    #[inline]
+    pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        with_bvh!(self, bvh => bvh.intersect(ray))
+    }
+
+    /// As [`Accel::intersect`], counting nodes and blocks visited into `stats`.
+    pub fn intersect_counted(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
+        with_bvh!(self, bvh => bvh.intersect_counted(ray, stats))
+    }
+
+    /// True if anything lies on the ray with `t` in `(0, ray.tmax]`.
+    #[inline]
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        with_bvh!(self, bvh => bvh.occluded(ray))
+    }
+
+    /// As [`Accel::occluded`], counting nodes and blocks visited into `stats`.
+    pub fn occluded_counted(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
+        with_bvh!(self, bvh => bvh.occluded_counted(ray, stats))
+    }
+
+    /// Readies `batch` for many rays leaving `origin` inside `region` (see [`OriginBatch`]).
+    #[inline]
+    pub fn prepare_batch(&self, batch: &mut OriginBatch, origin: Vec3, region: &Region) {
+        with_bvh!(self, bvh => batch.prepare(bvh, origin, region))
+    }
+
+    /// [`Accel::occluded`] for a ray of a batch prepared with [`Accel::prepare_batch`].
+    #[inline]
+    pub fn occluded_in_batch(&self, batch: &OriginBatch, ray: &Ray) -> bool {
+        with_bvh!(self, bvh => batch.occluded(bvh, ray))
+    }
+}
