@@ -45,7 +45,7 @@ fn traversal(c: &mut Criterion) {
     });
     c.bench_function("256 shadow rays: shared-origin batch (incl. prepare)", |b| {
         b.iter(|| {
-            world.prepare_batch(&mut batch, origin, &shaft);
+            world.prepare_batch(&mut batch, origin, &shaft, rays.len() as u32);
             black_box(rays.iter().filter(|r| world.occluded_in_batch(&batch, r)).count())
         })
     });

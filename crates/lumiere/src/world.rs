@@ -109,8 +109,8 @@ impl World {
 
     /// Readies `batch` for many rays leaving `origin` inside `region` (see [`OriginBatch`]).
     #[inline]
-    pub fn prepare_batch(&self, batch: &mut OriginBatch, origin: Vec3, region: &Region) {
-        self.accel.prepare_batch(batch, origin, region);
+    pub fn prepare_batch(&self, batch: &mut OriginBatch, origin: Vec3, region: &Region, rays: u32) {
+        self.accel.prepare_batch(batch, origin, region, rays);
     }
 
     /// [`World::occluded`] for a ray of a batch prepared with [`World::prepare_batch`].

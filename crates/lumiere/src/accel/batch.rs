@@ -26,6 +26,19 @@ use crate::math::Ray;
 /// Beyond this many candidate blocks (of four triangles), per-ray traversal is cheaper.
 const MAX_CANDIDATE_BLOCKS: usize = 24;
 
+/// Fewer rays than this per origin do not pay for gathering their candidates: measured on the
+/// Cornell box (`--mode direct` and `--mode ao` at N = 2 to 256, one thread), a shaft towards a
+/// light triangle pays from about 8 rays, a hemisphere, which keeps more triangles, from about 32.
+const MIN_SHAFT_RAYS: u32 = 8;
+const MIN_HEMISPHERE_RAYS: u32 = 32;
+
+/// Scenes with more triangles than this never batch a hemisphere: an unbounded half-space above a
+/// surface holds a sizeable part of any such scene, far more than `MAX_CANDIDATE_BLOCKS` blocks, and
+/// finding that out cost walking dozens of nodes and blocks per origin before giving up (22% of an
+/// ambient-occlusion render of the 1.1M-triangle bunny). The choice depends on the scene alone, so
+/// the bytes stay the same whatever the thread count.
+const MAX_HEMISPHERE_SCENE_TRIANGLES: usize = 16 * 4 * MAX_CANDIDATE_BLOCKS;
+
 /// Four candidate triangles, SoA: the three Plücker edge vectors and the plane (normal, and the
 /// normal's dot product with the first corner relative to the origin).
 #[derive(Clone, Copy, Debug)]
@@ -83,6 +96,11 @@ impl Region {
         Region { planes, keep_above: [0.0; 4], count: 1 }
     }
 
+    /// Whether the region is a whole half-space (a hemisphere of directions), rather than a shaft.
+    fn is_half_space(&self) -> bool {
+        self.count == 1
+    }
+
     /// Mask of the block's `W` triangles that do not lie wholly at or below `keep_above` of a plane.
     #[inline(always)]
     fn keeps_triangles<const W: usize, L: Lanes<W>>(&self, vertices: &[[[f32; W]; 3]; 3]) -> u32 {
@@ -138,10 +156,27 @@ pub struct OriginBatch {
 }
 
 impl OriginBatch {
-    /// Gathers the triangles of `bvh` that may block rays from `origin` within `region`. Out of
-    /// line, one copy per BVH type and crate (see the note in `wide/traverse.rs`).
+    /// Gathers the triangles of `bvh` that may block `rays` rays from `origin` within `region`, or
+    /// decides up front that per-ray traversal will be cheaper (too few rays, too large a region).
+    /// Out of line, one copy per BVH type and crate (see the note in `wide/traverse.rs`).
     #[inline(never)]
-    pub fn prepare<const W: usize, L: Lanes<W>>(&mut self, bvh: &WideBvh<W, L>, origin: Vec3, region: &Region) {
+    pub fn prepare<const W: usize, L: Lanes<W>>(
+        &mut self,
+        bvh: &WideBvh<W, L>,
+        origin: Vec3,
+        region: &Region,
+        rays: u32,
+    ) {
+        self.origin = origin;
+        self.blocks.clear();
+        self.traverse = if region.is_half_space() {
+            rays < MIN_HEMISPHERE_RAYS || bvh.triangle_count() > MAX_HEMISPHERE_SCENE_TRIANGLES
+        } else {
+            rays < MIN_SHAFT_RAYS
+        };
+        if self.traverse || bvh.triangle_count() == 0 {
+            return;
+        }
         L::dispatch(
             #[inline(always)]
             || self.gather(bvh, origin, region),
@@ -150,12 +185,6 @@ impl OriginBatch {
 
     #[inline(always)]
     fn gather<const W: usize, L: Lanes<W>>(&mut self, bvh: &WideBvh<W, L>, origin: Vec3, region: &Region) {
-        self.origin = origin;
-        self.blocks.clear();
-        self.traverse = false;
-        if bvh.triangle_count() == 0 {
-            return;
-        }
         // Triangles kept but not yet packed into a block of four.
         let mut pending = arrayvec_like::Pending::default();
         // Depth-first walk of the region; a wide level pushes at most `W` children (one row of the

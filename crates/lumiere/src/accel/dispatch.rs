@@ -119,8 +119,8 @@ impl Accel {
 
     /// Readies `batch` for many rays leaving `origin` inside `region` (see [`OriginBatch`]).
     #[inline]
-    pub fn prepare_batch(&self, batch: &mut OriginBatch, origin: Vec3, region: &Region) {
-        with_bvh!(self, bvh => batch.prepare(bvh, origin, region))
+    pub fn prepare_batch(&self, batch: &mut OriginBatch, origin: Vec3, region: &Region, rays: u32) {
+        with_bvh!(self, bvh => batch.prepare(bvh, origin, region, rays))
     }
 
     /// [`Accel::occluded`] for a ray of a batch prepared with [`Accel::prepare_batch`].

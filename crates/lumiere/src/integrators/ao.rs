@@ -28,7 +28,7 @@ impl Integrator for AmbientOcclusion {
         // All probes leave from one origin into the half-space above the surface: trace them as a batch.
         let origin = surface.offset_origin(surface.ng);
         let mut batch = std::mem::take(&mut ctx.batch);
-        world.prepare_batch(&mut batch, origin, &Region::hemisphere(origin, surface.ng));
+        world.prepare_batch(&mut batch, origin, &Region::hemisphere(origin, surface.ng), self.samples);
         let mut visible = 0u32;
         for k in 0..self.samples {
             if ctx.must_stop(k) {

@@ -88,7 +88,7 @@ impl Integrator for Direct {
                         continue;
                     }
                     let Some(shaft) = Region::shaft(origin, light.shadow_targets) else { continue };
-                    world.prepare_batch(&mut batch, origin, &shaft);
+                    world.prepare_batch(&mut batch, origin, &shaft, n);
                     for k in 0..n {
                         if ctx.must_stop(k) {
                             break;

@@ -192,14 +192,14 @@ fn origin_batches_agree_with_traversal() {
                 Some(r) if rng.f32() < 0.5 => (r, true),
                 _ => (Region::hemisphere(origin, normal), false),
             };
-            batch.prepare(&wide, origin, &region);
+            batch.prepare(&wide, origin, &region, 64);
             batched += usize::from(batch.candidate_blocks().is_some());
             // The candidates are the triangles that survive culling, whatever the tree: an 8-wide
             // walk must gather the same ones (possibly packed in another order).
-            batch8.prepare(&wide8, origin, &region);
+            batch8.prepare(&wide8, origin, &region, 64);
             assert_eq!(batch8.candidate_blocks(), batch.candidate_blocks(), "mesh {mesh_index}");
             for (accel, accel_batch) in &mut accels {
-                accel.prepare_batch(accel_batch, origin, &region);
+                accel.prepare_batch(accel_batch, origin, &region, 64);
                 assert_eq!(accel_batch.candidate_blocks(), batch.candidate_blocks(), "mesh {mesh_index}");
             }
             for _ in 0..64 {
@@ -236,7 +236,7 @@ fn origin_batches_never_leak_through_a_closed_mesh() {
     let origin = Vec3::new(0.1, -0.2, 0.05);
     let mut batch = OriginBatch::default();
     for normal in [Vec3::X, Vec3::NEG_Y, Vec3::new(0.3, 0.4, -0.5).normalize()] {
-        batch.prepare(&wide, origin, &Region::hemisphere(origin, normal));
+        batch.prepare(&wide, origin, &Region::hemisphere(origin, normal), 64);
         assert!(batch.candidate_blocks().is_some());
         for &p in &positions {
             let dir = p - origin;
