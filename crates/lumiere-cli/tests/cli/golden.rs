@@ -7,7 +7,8 @@
 //! another order), and sample dimensions are now drawn from a cursor (`SampleStream`) instead of
 //! fixed numbers, so `direct` and `ao` draw other, equally distributed numbers: at 128x96 and 64
 //! spp their image means agree with the old renderer's within 0.1% (noise-level pixel differences).
-//! Then every PNG gained its sRGB chunk (decoded pixels unchanged), and `path` joined.
+//! Then every PNG gained its sRGB chunk (decoded pixels unchanged), and `path` joined, then the
+//! batched `ao` and `direct` cases (issue 11, before their ray-major kernels).
 
 use std::process::Command;
 
@@ -51,7 +52,7 @@ fn hashes_of(name: &str, scene_args: &[&str], args: &[&str]) -> (u64, u64) {
 type Case = (&'static str, &'static [&'static str], u64, u64);
 
 #[rustfmt::skip]
-const CASES: [Case; 8] = [
+const CASES: [Case; 11] = [
         ("hits", &["--mode", "hits"], 0xe5be6fadb7d0387a, 0x7d3cdc4ae8c8cc5c),
         ("materials", &["--mode", "materials"], 0xdadcc58aa85add45, 0x03b4ff564eb04fcc),
         ("shadows", &["--mode", "shadows"], 0x76e28bae8e2de7eb, 0x723af1f9843debe7),
@@ -70,7 +71,12 @@ const CASES: [Case; 8] = [
             0x3eb8316883e5fef2,
         ),
         ("path", &["--mode", "path", "--spp", "2", "--max-depth", "5"], 0xdd103c261bce61f9, 0x96e76b52e6c30b2f),
-    ];
+        // Enough rays per origin for shared-origin batches (below 8 per shaft or 32 per hemisphere
+        // each ray is traversed alone): recorded before the ray-major batch kernels.
+        ("ao-batch", &["--mode", "ao", "--samples", "40"], 0x3408fd741b8ed1f4, 0xf51ab36181dcf809),
+        ("ao-batch-near", &["--mode", "ao", "--samples", "33", "--spp", "2", "--ao-distance", "0.3"], 0x5ffe4e98288a909c, 0xdaa33abb590eab16),
+        ("direct-batch", &["--mode", "direct", "--samples", "16"], 0xab71b156a654ba78, 0xf1dda69e8cf8865f),
+];
 
 /// The renders of `CASES` whose bytes differ from the recorded ones, each with `extra` arguments.
 fn failures_with(extra: &[&str]) -> Vec<String> {
