@@ -113,6 +113,25 @@ impl World {
         self.accel.prepare_batch(batch, origin, region, rays);
     }
 
+    /// Runs `f` compiled for the ISA of the world's accel (see [`Accel::simd`]).
+    #[inline(always)]
+    pub fn simd<R>(&self, f: impl FnOnce() -> R) -> R {
+        self.accel.simd(f)
+    }
+
+    /// Which of the `live` rays among `N` leaving the origin of `batch` with directions `dirs`
+    /// (SoA) and one `tmax` are blocked, bit `i` for ray `i` (see [`Accel::occluded_lanes_in_batch`]).
+    #[inline(always)]
+    pub fn occluded_lanes_in_batch<const N: usize>(
+        &self,
+        batch: &OriginBatch,
+        dirs: &[[f32; N]; 3],
+        tmax: f32,
+        live: u32,
+    ) -> u32 {
+        self.accel.occluded_lanes_in_batch(batch, dirs, tmax, live)
+    }
+
     /// [`World::occluded`] for a ray of a batch prepared with [`World::prepare_batch`].
     #[inline]
     pub fn occluded_in_batch(&self, batch: &OriginBatch, ray: &Ray) -> bool {

@@ -234,6 +234,16 @@ impl OriginBatch {
         self.order_by_solid_angle();
     }
 
+    /// The origin the batch was prepared for.
+    pub fn origin(&self) -> Vec3 {
+        self.origin
+    }
+
+    /// Whether rays of this batch are traced one by one through the BVH (no candidates gathered).
+    pub fn traverses(&self) -> bool {
+        self.traverse
+    }
+
     /// Candidate blocks gathered, and whether rays fall back to traversal (for tests and tuning).
     pub fn candidate_blocks(&self) -> Option<usize> {
         (!self.traverse).then_some(self.blocks.len())
@@ -274,6 +284,45 @@ impl OriginBatch {
             let within = numerator.abs().le(tmax * denominator.abs());
             crosses & (ahead.bits() & within.bits()) != 0
         })
+    }
+}
+
+impl OriginBatch {
+    /// [`OriginBatch::occluded`] for `N <= 32` rays at once (directions SoA, one `tmax`), ray-major:
+    /// each candidate triangle is tested against every ray with the same operations, in the same
+    /// order, as the ray-by-ray test, so the answers are the same bits. Written as loops over the
+    /// rays, which the compiler vectorises in the ISA the caller runs in (`Accel::simd`). Bit `i` of
+    /// the result is set if ray `i` is blocked. The batch must have gathered candidates.
+    #[inline(always)]
+    pub fn occluded_lanes<const N: usize>(&self, dirs: &[[f32; N]; 3], tmax: f32) -> u32 {
+        const { assert!(N <= 32, "a lane mask is a u32") };
+        debug_assert!(!self.traverse);
+        let mut blocked = [false; N];
+        for block in &self.blocks {
+            for triangle in 0..4 {
+                let vector = |v: &[[f32; 4]; 3]| [v[0][triangle], v[1][triangle], v[2][triangle]];
+                let [e0, e1, e2] = [vector(&block.edges[0]), vector(&block.edges[1]), vector(&block.edges[2])];
+                let normal = vector(&block.normal);
+                let numerator = block.plane_offset[triangle];
+                for ray in 0..N {
+                    let d = [dirs[0][ray], dirs[1][ray], dirs[2][ray]];
+                    let dot = |v: [f32; 3]| d[0] * v[0] + d[1] * v[1] + d[2] * v[2];
+                    let (s0, s1, s2) = (dot(e0), dot(e1), dot(e2));
+                    let negative = (s0 < 0.0) | (s1 < 0.0) | (s2 < 0.0);
+                    let positive = (s0 > 0.0) | (s1 > 0.0) | (s2 > 0.0);
+                    let crosses = !(negative & positive) & (negative | positive);
+                    let denominator = dot(normal);
+                    let ahead = numerator * denominator > 0.0;
+                    let within = numerator.abs() <= tmax * denominator.abs();
+                    blocked[ray] |= crosses & ahead & within;
+                }
+            }
+            // Blocks come largest solid angle first: most rays of a closed room stop early.
+            if blocked.iter().all(|&b| b) {
+                break;
+            }
+        }
+        blocked.iter().enumerate().fold(0, |mask, (i, &b)| mask | u32::from(b) << i)
     }
 }
 

@@ -123,6 +123,51 @@ impl Accel {
         with_bvh!(self, bvh => batch.prepare(bvh, origin, region, rays))
     }
 
+    /// Runs `f` compiled for this accel's ISA: code inlined into `f` (pass an `#[inline(always)]`
+    /// closure) may use its vector width, e.g. loops over arrays of lanes that the compiler
+    /// vectorises. Each lane performs the scalar IEEE operations, so the results do not depend on
+    /// the ISA.
+    #[inline(always)]
+    pub fn simd<R>(&self, f: impl FnOnce() -> R) -> R {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use super::simd::avx::{Avx2, Avx512, AvxLevel};
+            match self.bvh {
+                // SAFETY: an accel of these ISAs is only built where the CPU supports them (`from_binary`).
+                IsaBvh::Avx512(_) => return unsafe { Avx512::run(f) },
+                // SAFETY: as above.
+                IsaBvh::Avx2(_) => return unsafe { Avx2::run(f) },
+                _ => {}
+            }
+        }
+        f()
+    }
+
+    /// Which of the `live` rays (bit `i` for ray `i`) among `N` from the origin of a batch prepared
+    /// with [`Accel::prepare_batch`], with the directions `dirs` (SoA) and one `tmax`, are blocked.
+    /// The same answers as [`Accel::occluded_in_batch`] ray by ray; bits outside `live` mean nothing.
+    #[inline(always)]
+    pub fn occluded_lanes_in_batch<const N: usize>(
+        &self,
+        batch: &OriginBatch,
+        dirs: &[[f32; N]; 3],
+        tmax: f32,
+        live: u32,
+    ) -> u32 {
+        if !batch.traverses() {
+            return batch.occluded_lanes(dirs, tmax);
+        }
+        let mut blocked = 0;
+        let mut rays = live;
+        while rays != 0 {
+            let lane = rays.trailing_zeros() as usize;
+            rays &= rays - 1;
+            let dir = Vec3::new(dirs[0][lane], dirs[1][lane], dirs[2][lane]);
+            blocked |= u32::from(self.occluded(&Ray { origin: batch.origin(), dir, tmax })) << lane;
+        }
+        blocked
+    }
+
     /// [`Accel::occluded`] for a ray of a batch prepared with [`Accel::prepare_batch`].
     #[inline]
     pub fn occluded_in_batch(&self, batch: &OriginBatch, ray: &Ray) -> bool {

@@ -1,8 +1,9 @@
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 use super::{Integrator, SampleContext};
-use crate::accel::Region;
+use crate::accel::{OriginBatch, Region};
 use crate::math::{Frame, Ray};
+use crate::sampler::PointSet;
 use crate::sampling::warp::sample_cosine_hemisphere;
 use crate::world::World;
 
@@ -18,6 +19,9 @@ pub struct AmbientOcclusion {
     pub distance: f32,
 }
 
+/// Probes drawn and tested together: one AVX-512 register of f32 (two AVX2 ones).
+const LANES: usize = 16;
+
 impl Integrator for AmbientOcclusion {
     fn radiance(&self, world: &World, ray: &Ray, ctx: &mut SampleContext) -> Vec3 {
         ctx.rays += 1;
@@ -29,17 +33,47 @@ impl Integrator for AmbientOcclusion {
         let origin = surface.offset_origin(surface.ng);
         let mut batch = std::mem::take(&mut ctx.batch);
         world.prepare_batch(&mut batch, origin, &Region::hemisphere(origin, surface.ng), self.samples);
-        let mut visible = 0u32;
-        for k in 0..self.samples {
-            if ctx.must_stop(k) {
-                break;
-            }
-            let dir = frame.to_world(sample_cosine_hemisphere(directions.get_2d(k)));
-            let probe = Ray { origin, dir, tmax: self.distance };
-            visible += u32::from(!world.occluded_in_batch(&batch, &probe));
-        }
+        let visible = world.simd(
+            #[inline(always)]
+            || self.count_visible(world, &batch, &frame, &directions, ctx),
+        );
         ctx.batch = batch;
         ctx.rays += u64::from(self.samples);
         Vec3::splat(visible as f32 / self.samples as f32)
+    }
+}
+
+impl AmbientOcclusion {
+    /// How many of the probes reach the sky, `LANES` at a time: their directions are computed in
+    /// loops over the lanes (vectorised in the world's ISA; each lane does the scalar operations,
+    /// so the bits do not depend on it), then tested together against the batch.
+    #[inline(always)]
+    fn count_visible(
+        &self,
+        world: &World,
+        batch: &OriginBatch,
+        frame: &Frame,
+        directions: &PointSet,
+        ctx: &SampleContext,
+    ) -> u32 {
+        let mut visible = 0;
+        for first in (0..self.samples).step_by(LANES) {
+            // Polled as often as one probe at a time polled it (every `STOP_POLL` probes).
+            if ctx.must_stop(first + LANES as u32 - 1) {
+                break;
+            }
+            // The random numbers first: the sampler is a call per point, which would keep the
+            // warp below from being vectorised if it sat in the same loop.
+            let points: [Vec2; LANES] = std::array::from_fn(|lane| directions.get_2d(first + lane as u32));
+            let mut dirs = [[0.0; LANES]; 3];
+            for lane in 0..LANES {
+                let dir = frame.to_world(sample_cosine_hemisphere(points[lane]));
+                [dirs[0][lane], dirs[1][lane], dirs[2][lane]] = dir.to_array();
+            }
+            let live = u32::MAX >> (32 - (self.samples - first).min(LANES as u32));
+            let blocked = world.occluded_lanes_in_batch(batch, &dirs, self.distance, live);
+            visible += (live & !blocked).count_ones();
+        }
+        visible
     }
 }

@@ -1,11 +1,12 @@
 use glam::Vec3;
 
 use super::{Integrator, SampleContext, shading_frame};
-use crate::accel::Region;
+use crate::accel::{OriginBatch, Region};
 use crate::geometry::surface::SurfacePoint;
 use crate::lights::{AreaLight, LightSample, LightSelection};
 use crate::materials::Bsdf;
 use crate::math::{Frame, Ray};
+use crate::sampler::PointSet;
 use crate::world::World;
 
 /// How the direct-light estimator spends its samples.
@@ -50,6 +51,58 @@ impl<B: Bsdf> Receiver<'_, B> {
     }
 }
 
+/// Shadow rays drawn and tested together: one AVX-512 register of f32 (two AVX2 ones).
+const LANES: usize = 16;
+
+impl<B: Bsdf> Receiver<'_, B> {
+    /// `sum` plus `f Le V cos(theta) / pdf` of each of the `n` points of `light` drawn from
+    /// `points`, `LANES` at a time: their contributions are computed lane by lane, their shadow
+    /// segments tested together against the batch (prepared for the shaft to the light), and the
+    /// visible ones added to `sum` in sample order, so it has the bits of one sample at a time.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn add_light(
+        &self,
+        mut sum: Vec3,
+        world: &World,
+        light: u32,
+        points: &PointSet,
+        n: u32,
+        batch: &OriginBatch,
+        ctx: &mut SampleContext,
+    ) -> Vec3 {
+        let lights = world.lights();
+        let origin = batch.origin();
+        for first in (0..n).step_by(LANES) {
+            // Polled as often as one sample at a time polled it (every `STOP_POLL` samples).
+            if ctx.must_stop(first + LANES as u32 - 1) {
+                break;
+            }
+            let count = (n - first).min(LANES as u32) as usize;
+            let mut contributions = [Vec3::ZERO; LANES];
+            let mut segments = [[0.0; LANES]; 3];
+            let mut traced = 0u32;
+            for lane in 0..count {
+                let u = points.get_2d(first + lane as u32);
+                let Some(sample) = lights.sample_li_on(light, self.surface.p, u) else { continue };
+                let Some(contribution) = self.unshadowed(&sample) else { continue };
+                contributions[lane] = contribution;
+                // `Ray::segment(origin, target)`: the direction is the whole segment, tmax 1.
+                [segments[0][lane], segments[1][lane], segments[2][lane]] = (sample.target - origin).to_array();
+                traced |= 1 << lane;
+            }
+            ctx.rays += u64::from(traced.count_ones());
+            let visible = traced & !world.occluded_lanes_in_batch(batch, &segments, 1.0, traced);
+            for (lane, contribution) in contributions.iter().enumerate() {
+                if visible & (1 << lane) != 0 {
+                    sum += *contribution;
+                }
+            }
+        }
+        sum
+    }
+}
+
 /// False when no point of the light can contribute: the light lies wholly below the surface's
 /// tangent plane, or the surface lies behind the light. Saves preparing a batch for nothing.
 fn faces_each_other(surface: &SurfacePoint, light: &AreaLight) -> bool {
@@ -89,19 +142,11 @@ impl Integrator for Direct {
                     }
                     let Some(shaft) = Region::shaft(origin, light.shadow_targets) else { continue };
                     world.prepare_batch(&mut batch, origin, &shaft, n);
-                    for k in 0..n {
-                        if ctx.must_stop(k) {
-                            break;
-                        }
-                        let Some(sample) = lights.sample_li_on(index as u32, surface.p, points.get_2d(k)) else {
-                            continue;
-                        };
-                        let Some(contribution) = receiver.unshadowed(&sample) else { continue };
-                        ctx.rays += 1;
-                        if !world.occluded_in_batch(&batch, &Ray::segment(origin, sample.target)) {
-                            sum += contribution;
-                        }
-                    }
+                    let light = index as u32;
+                    sum = world.simd(
+                        #[inline(always)]
+                        || receiver.add_light(sum, world, light, &points, n, &batch, ctx),
+                    );
                 }
                 ctx.batch = batch;
             }

@@ -131,12 +131,12 @@ pub fn sin_cos_turns(turns: f32) -> (f32, f32) {
     let a2 = a * a;
     let sin = a * (1.0 + a2 * (-1.0 / 6.0 + a2 * (1.0 / 120.0 + a2 * (-1.0 / 5040.0 + a2 * (1.0 / 362_880.0)))));
     let cos = 1.0 + a2 * (-0.5 + a2 * (1.0 / 24.0 + a2 * (-1.0 / 720.0 + a2 * (1.0 / 40_320.0))));
-    match (quadrant as i32) & 3 {
-        0 => (sin, cos),
-        1 => (cos, -sin),
-        2 => (-sin, -cos),
-        _ => (-cos, sin),
-    }
+    // Rotate back by the quadrant q: (sin, cos), (cos, -sin), (-sin, -cos), (-cos, sin) for q = 0..3,
+    // written as selects rather than a match, so that loops over many angles vectorise (a match
+    // compiled to a jump table on a random quadrant).
+    let q = quadrant as i32;
+    let (a, b) = if q & 1 == 0 { (sin, cos) } else { (cos, sin) };
+    (if q & 2 == 0 { a } else { -a }, if (q + 1) & 2 == 0 { b } else { -b })
 }
 
 /// `φ / 2π ∈ [0, 1)` for the azimuth `φ` of `w` around `+z`; 0 on the axis, where `φ` is arbitrary.

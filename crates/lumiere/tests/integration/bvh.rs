@@ -202,7 +202,10 @@ fn origin_batches_agree_with_traversal() {
                 accel.prepare_batch(accel_batch, origin, &region, 64);
                 assert_eq!(accel_batch.candidate_blocks(), batch.candidate_blocks(), "mesh {mesh_index}");
             }
-            for _ in 0..64 {
+            // The rays of this origin, 16 to a group, for the ray-major test.
+            let mut group = [[0.0f32; 16]; 3];
+            let mut group_answers = 0u32;
+            for k in 0..64 {
                 let ray = if shaft {
                     let (a, b) = (rng.f32(), rng.f32());
                     let (a, b) = if a + b > 1.0 { (1.0 - a, 1.0 - b) } else { (a, b) };
@@ -219,6 +222,18 @@ fn origin_batches_agree_with_traversal() {
                 for (accel, accel_batch) in &accels {
                     let isa = accel.isa();
                     assert_eq!(accel.occluded_in_batch(accel_batch, &ray), occluded, "mesh {mesh_index}: {isa} batch");
+                }
+                let lane = k % 16;
+                [group[0][lane], group[1][lane], group[2][lane]] = ray.dir.to_array();
+                group_answers |= u32::from(occluded) << lane;
+                if lane == 15 {
+                    // All rays of a group share `tmax` (1 for segments, infinity for directions).
+                    for (accel, accel_batch) in &accels {
+                        let (isa, live) = (accel.isa(), 0xFFFF);
+                        let blocked = accel.occluded_lanes_in_batch(accel_batch, &group, ray.tmax, live);
+                        assert_eq!(blocked & live, group_answers, "mesh {mesh_index}: {isa} ray-major batch");
+                    }
+                    group_answers = 0;
                 }
             }
         }

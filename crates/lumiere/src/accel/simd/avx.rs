@@ -32,7 +32,8 @@ pub trait AvxLevel: Copy + Debug {
 #[derive(Clone, Copy, Debug)]
 pub struct Avx2;
 
-/// AVX-512 Foundation with the 256-bit (VL) encodings: Skylake-X and later, Zen 4 and later.
+/// AVX-512 Foundation with the 256-bit (VL) encodings and 64-bit integer multiplies (DQ, which
+/// the samplers' hashes use): Skylake-X and later, Zen 4 and later.
 #[derive(Clone, Copy, Debug)]
 pub struct Avx512;
 
@@ -53,15 +54,18 @@ impl AvxLevel for Avx2 {
 
 impl AvxLevel for Avx512 {
     fn supported() -> bool {
-        is_x86_feature_detected!("avx2") && is_x86_feature_detected!("avx512f") && is_x86_feature_detected!("avx512vl")
+        is_x86_feature_detected!("avx2")
+            && is_x86_feature_detected!("avx512f")
+            && is_x86_feature_detected!("avx512vl")
+            && is_x86_feature_detected!("avx512dq")
     }
     #[inline(always)]
     unsafe fn run<R>(f: impl FnOnce() -> R) -> R {
-        #[target_feature(enable = "avx,avx2,avx512f,avx512vl")]
+        #[target_feature(enable = "avx,avx2,avx512f,avx512vl,avx512dq")]
         unsafe fn with_avx512<R>(f: impl FnOnce() -> R) -> R {
             f()
         }
-        // SAFETY: the caller guarantees AVX-512 F and VL (and AVX2).
+        // SAFETY: the caller guarantees AVX-512 F, VL and DQ (and AVX2).
         unsafe { with_avx512(f) }
     }
 }

@@ -12,7 +12,7 @@ pub enum Isa {
     Sse2,
     /// AVX2: the 8-wide BVH with 256-bit kernels.
     Avx2,
-    /// AVX-512 F and VL: the 8-wide BVH compiled with AVX-512's registers and masks.
+    /// AVX-512 F, VL and DQ: the 8-wide BVH compiled with AVX-512's registers and masks.
     Avx512,
 }
 
