@@ -51,8 +51,8 @@ impl Checkpoint {
             out.extend_from_slice(&v.to_le_bytes());
         }
         out.extend_from_slice(&self.stats.elapsed.as_secs_f64().to_le_bytes());
-        for (sum, sq) in film.sum.iter().zip(&film.sum_sq) {
-            for v in sum.iter().chain([sq]) {
+        for (sum, sq) in film.moments() {
+            for v in sum.into_iter().chain([sq]) {
                 out.extend_from_slice(&v.to_le_bytes());
             }
         }
@@ -111,13 +111,8 @@ impl Checkpoint {
         let Ok(elapsed) = Duration::try_from_secs_f64(elapsed) else {
             return Err(bad("invalid elapsed time"));
         };
-        let mut film = Film::new(width, height)?;
-        for (sum, sq) in film.sum.iter_mut().zip(film.sum_sq.iter_mut()) {
-            *sum = [reader.f64(), reader.f64(), reader.f64()];
-            *sq = reader.f64();
-        }
-        film.samples = samples;
-        film.discarded = discarded;
+        let moments = std::iter::from_fn(|| Some(([reader.f64(), reader.f64(), reader.f64()], reader.f64())));
+        let film = Film::from_moments(width, height, samples, discarded, moments)?;
         let stats = RenderStats { rays, elapsed };
         Ok(Checkpoint { scene_fingerprint, options_fingerprint, seed, options, film, stats })
     }

@@ -1,7 +1,7 @@
-//! Progressive rendering: passes of one camera sample per pixel over the whole image, each pass
-//! split into tiles scheduled with rayon. A pixel's samples depend only on the pixel, the sample
-//! index and the options, never on the thread that ran them, and passes are accumulated in order,
-//! so images are identical for any thread count and for any stopping point.
+//! Progressive rendering: passes of one camera sample per pixel over the whole image (`pass.rs`),
+//! each added to the film when it is complete. A pixel's samples depend only on the pixel, the
+//! sample index and the options, never on the thread that ran them, and passes are accumulated in
+//! order, so images are identical for any thread count and for any stopping point.
 
 /// Runs `$body` with `$integrator` bound to the integrator of `$technique`: one monomorphised render
 /// loop per technique, no dynamic dispatch per sample.
@@ -23,6 +23,7 @@ pub mod checkpoint;
 pub mod film;
 pub mod fingerprint;
 mod options;
+mod pass;
 pub mod range;
 
 pub use options::RenderOptions;
@@ -32,21 +33,14 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, RecvTimeoutError};
 use std::time::{Duration, Instant};
 
-use glam::Vec3;
-use rayon::prelude::*;
-
-use crate::accel::OriginBatch;
 use crate::error::{Error, Result};
-use crate::integrators::{Integrator, SampleContext};
-use crate::math::Ray;
-use crate::sampler::{SampleStream, Sampler};
+use crate::integrators::Integrator;
+use crate::sampler::Sampler;
 use crate::scene::camera::Camera;
 use crate::world::World;
 use film::{Film, Image};
-
-/// Tiles are small enough to balance two cores and to notice an interruption within milliseconds,
-/// and large enough that scheduling costs nothing.
-const TILE_SIZE: u32 = 16;
+pub(crate) use pass::camera_sample;
+use pass::{Pass, pass_buffer, render_pass};
 
 /// Why a render stopped.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -148,8 +142,10 @@ fn run_passes<I: Integrator>(
     let start = Instant::now();
     let before = stats.elapsed;
     let sampler = Sampler::new(options.sampler, options.seed);
-    let tiles = tiles(camera.width, camera.height);
     let pixel_centre = options.samples_pixel_centres();
+    // The buffer passes render into, allocated when a pass needs one: the first pass's becomes the
+    // film (no copy), and every later pass reuses a second one.
+    let mut buffer = Vec::new();
     let expired = AtomicBool::new(false);
     // Checked between passes, before every pixel and inside costly pixels, so that a render of
     // thousands of samples or lights per pixel neither outlives its budget nor ignores Ctrl-C. Two
@@ -183,22 +179,23 @@ fn run_passes<I: Integrator>(
                 break (reason, Ok(()));
             }
             let pass = Pass { sampler: &sampler, sample: film.samples, pixel_centre };
-            let Some(tile_values) = render_pass(integrator, world, camera, &pass, &tiles, hooks.progress, &stop_now)
+            if buffer.is_empty() {
+                buffer = pass_buffer(camera.width, camera.height);
+            }
+            let Some(rays) = render_pass(integrator, world, camera, &pass, &mut buffer, hooks.progress, &stop_now)
             else {
                 // The pass in flight is abandoned: the film keeps whole passes only.
                 break (stop_now().unwrap_or(StopReason::Interrupted), Ok(()));
             };
-            for (tile, (values, rays)) in tiles.iter().zip(tile_values) {
-                film.add_tile(tile.x0, tile.y0, tile.x1 - tile.x0, &values);
-                stats.rays += rays;
-            }
-            film.samples += 1;
+            film.add_rendered(&mut buffer);
+            stats.rays += rays;
             stats.elapsed = before + start.elapsed();
             if let Err(e) = (hooks.pass_done)(&film, &stats) {
                 break (StopReason::Interrupted, Err(e));
             }
-            if let (Some(target), Some(error)) = (options.noise_target, film.relative_error())
-                && error <= target
+            // Only with a target: the estimate is a serial sweep over the film.
+            if let Some(target) = options.noise_target
+                && film.relative_error().is_some_and(|error| error <= target)
             {
                 break (StopReason::NoiseTarget, Ok(()));
             }
@@ -209,82 +206,4 @@ fn run_passes<I: Integrator>(
     result?;
     stats.elapsed = before + start.elapsed();
     Ok(RenderOutput { image: film.image(), film, stats, stop })
-}
-
-/// What every pixel of one pass shares.
-struct Pass<'a> {
-    sampler: &'a Sampler,
-    /// The camera sample index of this pass.
-    sample: u32,
-    /// Sample pixel centres (the lab's single ray) rather than jittered positions.
-    pixel_centre: bool,
-}
-
-/// The camera ray of sample `sample` of pixel `(x, y)`, and that sample's random numbers with the
-/// pixel position already drawn from their first dimension (drawn even for pixel centres, so that
-/// the integrator's dimensions do not depend on it). The one place a sample's position is decided:
-/// the render and its AOVs go through it, so they line up.
-pub(crate) fn camera_sample<'a>(
-    camera: &Camera,
-    sampler: &'a Sampler,
-    (x, y): (u32, u32),
-    sample: u32,
-    pixel_centre: bool,
-) -> (Ray, SampleStream<'a>) {
-    let mut stream = SampleStream::new(sampler, y * camera.width + x, sample);
-    let jitter = stream.next_points(1);
-    let offset = if pixel_centre { glam::Vec2::splat(0.5) } else { jitter.get_2d(0) };
-    (camera.ray(x as f32 + offset.x, y as f32 + offset.y), stream)
-}
-
-/// One sample per pixel: per tile, its values row by row and its rays; `None` as soon as
-/// `stop_now` says so (checked before every pixel, and by integrators inside costly pixels).
-fn render_pass<I: Integrator>(
-    integrator: &I,
-    world: &World,
-    camera: &Camera,
-    pass: &Pass,
-    tiles: &[Tile],
-    progress: &(dyn Fn(u64) + Sync),
-    stop_now: &(dyn Fn() -> Option<StopReason> + Sync),
-) -> Option<Vec<(Vec<Vec3>, u64)>> {
-    tiles
-        .par_iter()
-        .map(|tile| {
-            let stream = SampleStream::new(pass.sampler, 0, pass.sample);
-            let stop = || stop_now().is_some();
-            let mut ctx = SampleContext { stream, batch: OriginBatch::default(), rays: 0, stop: &stop };
-            let mut values = Vec::with_capacity(((tile.x1 - tile.x0) * (tile.y1 - tile.y0)) as usize);
-            for y in tile.y0..tile.y1 {
-                for x in tile.x0..tile.x1 {
-                    if stop_now().is_some() {
-                        return None;
-                    }
-                    let (ray, stream) = camera_sample(camera, pass.sampler, (x, y), pass.sample, pass.pixel_centre);
-                    ctx.stream = stream;
-                    values.push(integrator.radiance(world, &ray, &mut ctx));
-                }
-            }
-            progress(values.len() as u64);
-            Some((values, ctx.rays))
-        })
-        .collect()
-}
-
-#[derive(Clone, Copy)]
-struct Tile {
-    x0: u32,
-    y0: u32,
-    x1: u32,
-    y1: u32,
-}
-
-fn tiles(width: u32, height: u32) -> Vec<Tile> {
-    let mut out = Vec::new();
-    for y0 in (0..height).step_by(TILE_SIZE as usize) {
-        for x0 in (0..width).step_by(TILE_SIZE as usize) {
-            out.push(Tile { x0, y0, x1: (x0 + TILE_SIZE).min(width), y1: (y0 + TILE_SIZE).min(height) });
-        }
-    }
-    out
 }

@@ -14,7 +14,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use glam::Vec3;
 
 use super::film::PassSamples;
-use super::{Pass, RenderOptions, StopReason, render_pass, tiles};
+use super::pass::{Pass, pass_buffer, render_pass};
+use super::{RenderOptions, StopReason};
 use crate::error::{Error, Result};
 use crate::integrators::Integrator;
 use crate::sampler::Sampler;
@@ -66,26 +67,17 @@ fn run_range<I: Integrator>(
     cancel: &AtomicBool,
 ) -> Vec<PassSamples> {
     let sampler = Sampler::new(options.sampler, options.seed);
-    let tiles = tiles(camera.width, camera.height);
     let pixel_centre = options.samples_pixel_centres();
     let stop_now = || cancel.load(Ordering::Relaxed).then_some(StopReason::Interrupted);
-    let width = camera.width as usize;
     let mut passes = Vec::with_capacity(samples.len());
     for sample in samples {
         let pass = Pass { sampler: &sampler, sample, pixel_centre };
-        let Some(tile_values) = render_pass(integrator, world, camera, &pass, &tiles, progress, &stop_now) else {
+        let mut values = pass_buffer(camera.width, camera.height);
+        let Some(rays) = render_pass(integrator, world, camera, &pass, &mut values, progress, &stop_now) else {
             break;
         };
-        let mut values = vec![Vec3::ZERO; width * camera.height as usize];
-        let mut rays = 0;
-        for (tile, (tile_values, tile_rays)) in tiles.iter().zip(tile_values) {
-            let tile_width = (tile.x1 - tile.x0) as usize;
-            for (row, chunk) in tile_values.chunks(tile_width).enumerate() {
-                let start = (tile.y0 as usize + row) * width + tile.x0 as usize;
-                values[start..start + tile_width].copy_from_slice(chunk);
-            }
-            rays += tile_rays;
-        }
+        // In place: arrays and `Vec3` have the same size and alignment, so the buffer is reused.
+        let values = values.into_iter().map(Vec3::from).collect();
         passes.push(PassSamples { sample, width: camera.width, height: camera.height, values, rays });
     }
     passes

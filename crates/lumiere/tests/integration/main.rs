@@ -6,6 +6,7 @@ mod bsdfs;
 mod bvh;
 mod camera;
 mod estimators;
+mod film;
 mod hostile_inputs;
 mod image_io;
 mod module_graph;

@@ -1,0 +1,126 @@
+//! One pass: one camera sample per pixel, shaded straight into a buffer of the image's size, row
+//! by row. Pixels are shaded tile by tile on rayon (tiles keep rays coherent, balance the cores and
+//! notice a stop within milliseconds), and every tile is handed its own pieces of the buffer's
+//! rows: disjoint borrows, so workers write each value where it belongs, with no lock, no buffer
+//! per tile and no copy afterwards.
+
+use glam::Vec2;
+use rayon::prelude::*;
+
+use super::StopReason;
+use crate::accel::OriginBatch;
+use crate::integrators::{Integrator, SampleContext};
+use crate::math::Ray;
+use crate::sampler::{SampleStream, Sampler};
+use crate::scene::camera::Camera;
+use crate::world::World;
+
+/// Tiles are small enough to balance two cores and to notice an interruption within milliseconds,
+/// and large enough that scheduling costs nothing.
+const TILE_SIZE: usize = 16;
+
+/// What every pixel of one pass shares.
+pub(super) struct Pass<'a> {
+    pub sampler: &'a Sampler,
+    /// The camera sample index of this pass.
+    pub sample: u32,
+    /// Sample pixel centres (the lab's single ray) rather than jittered positions.
+    pub pixel_centre: bool,
+}
+
+/// A buffer for one pass of a `width` x `height` image. Arrays rather than `Vec3`: a `vec!` of
+/// zero arrays is allocated zeroed (calloc), its pages first touched by the workers that write
+/// them, in parallel, where `vec![Vec3::ZERO; n]` fills every pixel on one thread first (4 ms at
+/// 1024x768).
+pub(super) fn pass_buffer(width: u32, height: u32) -> Vec<[f32; 3]> {
+    vec![[0.0; 3]; width as usize * height as usize]
+}
+
+/// The camera ray of sample `sample` of pixel `(x, y)`, and that sample's random numbers with the
+/// pixel position already drawn from their first dimension (drawn even for pixel centres, so that
+/// the integrator's dimensions do not depend on it). The one place a sample's position is decided:
+/// the render and its AOVs go through it, so they line up.
+pub(crate) fn camera_sample<'a>(
+    camera: &Camera,
+    sampler: &'a Sampler,
+    (x, y): (u32, u32),
+    sample: u32,
+    pixel_centre: bool,
+) -> (Ray, SampleStream<'a>) {
+    let mut stream = SampleStream::new(sampler, y * camera.width + x, sample);
+    let jitter = stream.next_points(1);
+    let offset = if pixel_centre { Vec2::splat(0.5) } else { jitter.get_2d(0) };
+    (camera.ray(x as f32 + offset.x, y as f32 + offset.y), stream)
+}
+
+/// Shades one sample per pixel into `buffer` (one value per pixel, row by row, as the integrator
+/// returned it) and returns the rays traced; `None` as soon as `stop_now` says so (checked before
+/// every pixel, and by integrators inside costly pixels), the buffer then holding part of a pass.
+pub(super) fn render_pass<I: Integrator>(
+    integrator: &I,
+    world: &World,
+    camera: &Camera,
+    pass: &Pass,
+    buffer: &mut [[f32; 3]],
+    progress: &(dyn Fn(u64) + Sync),
+    stop_now: &(dyn Fn() -> Option<StopReason> + Sync),
+) -> Option<u64> {
+    let width = camera.width as usize;
+    debug_assert_eq!(buffer.len(), width * camera.height as usize);
+    let shade = |tile: Tile| shade_tile(integrator, world, camera, pass, tile, progress, stop_now);
+    buffer
+        .par_chunks_mut(width * TILE_SIZE)
+        .enumerate()
+        .map(|(band, rows)| {
+            // Each row of the band cut at the tile edges, the pieces regrouped tile by tile.
+            let height = rows.len() / width;
+            let mut cut: Vec<_> = rows.chunks_mut(width).map(|row| row.chunks_mut(TILE_SIZE)).collect();
+            let columns = width.div_ceil(TILE_SIZE);
+            let mut pieces = Vec::with_capacity(columns * height);
+            for _ in 0..columns {
+                pieces.extend(cut.iter_mut().filter_map(Iterator::next));
+            }
+            pieces
+                .par_chunks_mut(height)
+                .enumerate()
+                .map(|(column, rows)| shade(Tile { x0: column * TILE_SIZE, y0: band * TILE_SIZE, rows }))
+                .try_reduce(|| 0, |a, b| Some(a + b))
+        })
+        .try_reduce(|| 0, |a, b| Some(a + b))
+}
+
+/// A tile of the image: its top left pixel and its rows, each a piece of a row of the pass buffer.
+struct Tile<'a, 'b> {
+    x0: usize,
+    y0: usize,
+    rows: &'a mut [&'b mut [[f32; 3]]],
+}
+
+/// Shades the pixels of `tile`; the rays traced, or `None` if `stop_now` stopped it.
+fn shade_tile<I: Integrator>(
+    integrator: &I,
+    world: &World,
+    camera: &Camera,
+    pass: &Pass,
+    tile: Tile,
+    progress: &(dyn Fn(u64) + Sync),
+    stop_now: &(dyn Fn() -> Option<StopReason> + Sync),
+) -> Option<u64> {
+    let stream = SampleStream::new(pass.sampler, 0, pass.sample);
+    let stop = || stop_now().is_some();
+    let mut ctx = SampleContext { stream, batch: OriginBatch::default(), rays: 0, stop: &stop };
+    let mut pixels = 0;
+    for (y, row) in (tile.y0 as u32..).zip(tile.rows.iter_mut()) {
+        for (x, value) in (tile.x0 as u32..).zip(row.iter_mut()) {
+            if stop_now().is_some() {
+                return None;
+            }
+            let (ray, stream) = camera_sample(camera, pass.sampler, (x, y), pass.sample, pass.pixel_centre);
+            ctx.stream = stream;
+            *value = integrator.radiance(world, &ray, &mut ctx).to_array();
+        }
+        pixels += row.len() as u64;
+    }
+    progress(pixels);
+    Some(ctx.rays)
+}

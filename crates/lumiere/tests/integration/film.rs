@@ -1,0 +1,151 @@
+//! The film keeps its samples in the smallest exact form (nothing, one pass's values, f64 sums),
+//! and every form must hold the very bits of sums added pass after pass, the way the film always
+//! added them: `tests/cli/golden.rs` pins images, these pin the sums and second moments that
+//! checkpoints, resumes and noise targets read.
+
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+
+use glam::Vec3;
+use lumiere::integrators::Technique;
+use lumiere::render::checkpoint::Checkpoint;
+use lumiere::render::film::{Film, PassSamples, luminance};
+use lumiere::render::{Hooks, RenderOptions, RenderStats, StopReason, render_pass_range, render_progressive};
+use lumiere::scene::camera::Camera;
+use lumiere::scene::{Scene, builtin};
+use lumiere::world::World;
+
+const WIDTH: u32 = 5;
+const HEIGHT: u32 = 3;
+
+/// Pass `k`'s values: ordinary ones, and the ones the film must count as 0 or must not keep as
+/// they are (NaN, infinities, negatives, -0, a denormal, the largest float).
+fn pass(k: u32) -> PassSamples {
+    let odd = [
+        Vec3::new(f32::NAN, 1.0, 1.0),
+        Vec3::new(0.5, f32::INFINITY, 0.0),
+        Vec3::new(0.5, 0.25, f32::NEG_INFINITY),
+        Vec3::new(-1e-30, 2.0, 3.0),
+        Vec3::new(-0.0, -0.0, -0.0),
+        Vec3::new(-0.0, 0.75, 0.0),
+        Vec3::new(f32::MIN_POSITIVE / 4.0, 1e-3, 7.0),
+        Vec3::new(f32::MAX, 1.0, 0.0),
+    ];
+    let values = (0..WIDTH * HEIGHT)
+        .map(|p| {
+            let ordinary = Vec3::new(0.1 * (p + k) as f32, 1.0 / (1 + p * k) as f32, (p as f32).sqrt() / 3.0);
+            if (p + k).is_multiple_of(2) { odd[((p + 3 * k) % 8) as usize] } else { ordinary }
+        })
+        .collect();
+    PassSamples { sample: k, width: WIDTH, height: HEIGHT, values, rays: 1 }
+}
+
+/// The film's definition, written out plainly: f64 sums from zero, one addition per pass, invalid
+/// values counted and added as 0.
+struct Reference {
+    sum: Vec<[f64; 3]>,
+    sum_sq: Vec<f64>,
+    discarded: u64,
+}
+
+impl Reference {
+    fn add(&mut self, pass: &PassSamples) {
+        for (p, value) in pass.values.iter().enumerate() {
+            let valid = value.is_finite() && value.min_element() >= 0.0;
+            let v = if valid { *value } else { Vec3::ZERO };
+            self.discarded += u64::from(!valid);
+            for c in 0..3 {
+                self.sum[p][c] += v[c] as f64;
+            }
+            let y = luminance(v);
+            self.sum_sq[p] += y * y;
+        }
+    }
+}
+
+fn bits(moments: impl Iterator<Item = ([f64; 3], f64)>) -> Vec<u64> {
+    moments.flat_map(|(s, sq)| [s[0], s[1], s[2], sq]).map(f64::to_bits).collect()
+}
+
+fn image_bits(film: &Film) -> Vec<u32> {
+    film.image().pixels.iter().flat_map(|p| p.to_array()).map(f32::to_bits).collect()
+}
+
+#[test]
+fn every_form_holds_the_bits_of_one_addition_per_pass() {
+    let mut film = Film::new(WIDTH, HEIGHT).unwrap();
+    let mut reference = Reference { sum: vec![[0.0; 3]; 15], sum_sq: vec![0.0; 15], discarded: 0 };
+    assert_eq!(bits(film.moments()), bits(reference.sum.iter().copied().zip(reference.sum_sq.iter().copied())));
+    assert!(image_bits(&film).iter().all(|&b| b == 0), "an empty film is black (+0)");
+    for k in 0..4 {
+        film.add_pass(&pass(k)).unwrap();
+        reference.add(&pass(k));
+        let expected = reference.sum.iter().copied().zip(reference.sum_sq.iter().copied());
+        assert_eq!(bits(film.moments()), bits(expected), "after {} passes", k + 1);
+        assert_eq!((film.samples, film.discarded), (k + 1, reference.discarded));
+        let scale = 1.0 / (k + 1) as f64;
+        let mean: Vec<u32> = reference.sum.iter().flat_map(|s| s.map(|c| ((c * scale) as f32).to_bits())).collect();
+        assert_eq!(image_bits(&film), mean, "after {} passes", k + 1);
+    }
+}
+
+/// A checkpoint stores sums and second moments whatever the film's form: it loads as an equal
+/// film, which renders the same image and goes on the same way.
+#[test]
+fn checkpoints_of_every_form_resume_exactly() {
+    let mut film = Film::new(WIDTH, HEIGHT).unwrap();
+    for k in 0..4 {
+        let checkpoint = Checkpoint {
+            scene_fingerprint: 1,
+            options_fingerprint: 2,
+            seed: 3,
+            options: String::new(),
+            film: film.clone(),
+            stats: RenderStats::default(),
+        };
+        let mut loaded = Checkpoint::decode(&checkpoint.encode(), Path::new("film.ckpt")).unwrap().film;
+        assert_eq!(loaded, film, "after {k} passes");
+        assert_eq!(image_bits(&loaded), image_bits(&film), "after {k} passes");
+        assert_eq!(loaded.relative_error().map(f64::to_bits), film.relative_error().map(f64::to_bits));
+        film.add_pass(&pass(k)).unwrap();
+        loaded.add_pass(&pass(k)).unwrap();
+        assert_eq!(bits(loaded.moments()), bits(film.moments()), "resumed after {k} passes");
+        assert_eq!(loaded.discarded, film.discarded);
+    }
+}
+
+fn cornell() -> (World, Camera) {
+    let world = World::new(Scene::builtin().unwrap(), Default::default());
+    (world, Camera::from_orbiter(&builtin::cornell_orbiter().unwrap(), 96, 72))
+}
+
+/// Passes are shaded straight into a buffer that becomes the film or is added to it once the pass
+/// is complete: a pass stopped midway leaves no trace, whether it was the first or a later one.
+/// It stops after the pass's first tile of 30, so that tiles not yet started see the stop.
+#[test]
+fn a_pass_stopped_midway_leaves_the_film_as_it_was() {
+    let (world, camera) = cornell();
+    let options = RenderOptions { spp: 4, ..RenderOptions::new(Technique::direct(2)) };
+    let pixels = u64::from(camera.width * camera.height);
+    for stop_after in [1, pixels + 1] {
+        let cancel = AtomicBool::new(false);
+        let shaded = AtomicU64::new(0);
+        let progress = |n| {
+            if shaded.fetch_add(n, Ordering::Relaxed) + n >= stop_after {
+                cancel.store(true, Ordering::Relaxed);
+            }
+        };
+        let hooks = Hooks { progress: &progress, pass_done: &mut |_, _| Ok(()), cancel: &cancel };
+        let film = Film::new(camera.width, camera.height).unwrap();
+        let stopped = render_progressive(&world, &camera, &options, film, RenderStats::default(), hooks).unwrap();
+        let whole_passes = (stop_after / pixels) as u32;
+        assert_eq!((stopped.stop, stopped.film.samples), (StopReason::Interrupted, whole_passes));
+        let mut expected = Film::new(camera.width, camera.height).unwrap();
+        let never = AtomicBool::new(false);
+        for pass in render_pass_range(&world, &camera, &options, 0, whole_passes, &|_| {}, &never).unwrap() {
+            expected.add_pass(&pass).unwrap();
+        }
+        assert_eq!(stopped.film, expected, "stopped after {stop_after} pixel samples");
+        assert_eq!(stopped.image, expected.image());
+    }
+}
