@@ -7,7 +7,10 @@
 //! another order), and sample dimensions are now drawn from a cursor (`SampleStream`) instead of
 //! fixed numbers, so `direct` and `ao` draw other, equally distributed numbers: at 128x96 and 64
 //! spp their image means agree with the old renderer's within 0.1% (noise-level pixel differences).
-//! Then every PNG gained its sRGB chunk (decoded pixels unchanged), and `path` joined.
+//! Then every PNG gained its sRGB chunk (decoded pixels unchanged), and `path` joined. `path` then
+//! changed on purpose: one 2D point chooses the light and places the point on it (one dimension
+//! fewer per bounce) and an emitter hit's light pdf comes from the hit distance; over 16 seeds at
+//! 128x96, 16 spp, depth 5 its image mean moved by -0.03% (-0.5 standard errors).
 
 use std::process::Command;
 
@@ -58,7 +61,7 @@ fn every_mode_renders_the_bytes_recorded_before_the_reshape() {
             0xdd1e91c7a6954311,
             0x3eb8316883e5fef2,
         ),
-        ("path", &["--mode", "path", "--spp", "2", "--max-depth", "5"], 0xdd103c261bce61f9, 0x96e76b52e6c30b2f),
+        ("path", &["--mode", "path", "--spp", "2", "--max-depth", "5"], 0xa750647b5c874cc9, 0xd5f78a34b63f061a),
     ];
     let mut failures = Vec::new();
     for (name, args, pfm, png) in cases {
