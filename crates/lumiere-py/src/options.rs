@@ -41,7 +41,7 @@ impl PyOptions {
         mode: &str,
         spp: Option<i64>,
         seed: u64,
-        sampler: &str,
+        sampler: Option<&str>,
         samples: Option<i64>,
         light_sampling: Option<&str>,
         ao_distance: Option<f32>,
@@ -79,9 +79,12 @@ impl PyOptions {
             }
         };
         let sampler = match sampler {
-            "independent" => SamplerKind::Independent,
-            "sobol" => SamplerKind::Sobol,
-            other => return Err(invalid(format!("unknown sampler {other:?}: choose independent or sobol"))),
+            Some("independent") => SamplerKind::Independent,
+            Some("sobol") => SamplerKind::Sobol,
+            Some(other) => return Err(invalid(format!("unknown sampler {other:?}: choose independent or sobol"))),
+            // The CLI's defaults: Sobol for path tracing, the independent numbers for the lab's modes.
+            None if mode == "path" => SamplerKind::Sobol,
+            None => SamplerKind::Independent,
         };
         let seconds = |value: Option<f64>, what: &str| -> PyResult<Option<Duration>> {
             value

@@ -58,7 +58,7 @@ class NativeOptions:
         mode: str,
         spp: Optional[int],
         seed: int,
-        sampler: str,
+        sampler: Optional[str],
         samples: Optional[int] = None,
         light_sampling: Optional[str] = None,
         ao_distance: Optional[float] = None,

@@ -47,7 +47,7 @@ def _options(
     mode: str,
     spp: Optional[int],
     seed: int,
-    sampler: str,
+    sampler: Optional[str],
     time: Optional[float],
     noise: Optional[float],
     technique_options: Dict[str, Any],
@@ -62,7 +62,7 @@ def _options(
     if spp is not None and not isinstance(spp, (int, np.integer)):
         raise LumiereError(f"spp must be an integer, got {spp!r}")
     options = _lumiere.NativeOptions(
-        str(mode), None if spp is None else int(spp), seed, str(sampler), time=time, noise=noise, **technique_options
+        str(mode), None if spp is None else int(spp), seed, None if sampler is None else str(sampler), time=time, noise=noise, **technique_options
     )
     for message in options.ignored:
         warnings.warn(message, stacklevel=3)
@@ -94,7 +94,7 @@ def render_full(
     seed: int = 0,
     threads: int = 0,
     *,
-    sampler: str = "independent",
+    sampler: Optional[str] = None,
     size: Optional[Tuple[int, int]] = None,
     aovs: Sequence[str] = (),
     progress: Optional[Progress] = None,
@@ -130,7 +130,7 @@ def render(
     seed: int = 0,
     threads: int = 0,
     *,
-    sampler: str = "independent",
+    sampler: Optional[str] = None,
     size: Optional[Tuple[int, int]] = None,
     aovs: Sequence[str] = (),
     progress: Optional[Progress] = None,
@@ -150,7 +150,8 @@ def render(
         renders until ``time`` or ``noise`` stops it.
     :param seed: same seed, same values, whatever ``threads``.
     :param threads: worker threads, 0 = all cores.
-    :param sampler: ``independent`` or ``sobol``.
+    :param sampler: ``independent`` or ``sobol``; by default ``sobol`` for path, ``independent`` for
+        the lab's modes (as the CLI).
     :param aovs: names among ``albedo``, ``normal``, ``depth``: the result is then a dict with
         ``color`` and each AOV.
     :param progress: called as ``progress(done, total)`` in pixel samples, from the calling

@@ -61,12 +61,19 @@ impl Path {
         }
     }
 
-    /// The weight of light found by next-event estimation, against BSDF sampling.
+    /// The weight of light found by next-event estimation against BSDF sampling, divided by the
+    /// light sample's density `light_pdf` (positive): the power heuristic over the density is
+    /// `l / (l² + b²)`, one division where weight and density apart take two.
     #[inline]
-    fn light_weight(&self, light_pdf: f32, bsdf_pdf: f32) -> f32 {
+    fn light_weight_over_pdf(&self, light_pdf: f32, bsdf_pdf: f32) -> f32 {
         match self.strategy {
-            PathStrategy::Mis => power_heuristic(light_pdf, bsdf_pdf),
-            PathStrategy::LightsOnly => 1.0,
+            PathStrategy::Mis => {
+                let w = light_pdf / (light_pdf * light_pdf + bsdf_pdf * bsdf_pdf);
+                // `l² + b²` is infinite for an infinite `l` and 0 for a tiny one (the squares
+                // overflow or underflow): the ratio form holds there.
+                if w.is_finite() { w } else { power_heuristic(light_pdf, bsdf_pdf) / light_pdf }
+            }
+            PathStrategy::LightsOnly => 1.0 / light_pdf,
             PathStrategy::BsdfOnly => 0.0,
         }
     }
@@ -110,63 +117,67 @@ impl Integrator for Path {
         let lights = world.lights();
         let mut radiance = Vec3::ZERO;
         let mut throughput = Vec3::ONE;
-        let mut ray = *camera_ray;
-        // What the previous vertex knows about the ray that left it, for the MIS weight of the
-        // light it hits: its BSDF density (infinite for a delta lobe or the camera) and its position.
+        // Unit directions from here on (BSDF samples are unit vectors): `wo` needs no
+        // normalisation, and a hit's `t` is its distance, which the light pdf of an emitter hit uses.
+        let mut ray = Ray::new(camera_ray.origin, camera_ray.dir.normalize());
+        // The previous vertex's BSDF density for the ray that left it (infinite for a delta lobe
+        // or the camera), for the MIS weight of the light that ray hits.
         let mut previous_pdf = f32::INFINITY;
-        let mut previous_point = ray.origin;
         let mut depth = 0u32;
         loop {
             ctx.rays += 1;
             let Some(hit) = world.intersect(&ray) else { break };
-            let surface = world.surface(&ray, &hit);
 
             // Emission: the light this ray found, weighted against having sampled it as a light.
-            let emitted = world.emitted(hit.triangle, &ray);
-            if emitted != Vec3::ZERO {
-                let weight = match lights.light_of(hit.triangle) {
-                    Some(light) if previous_pdf.is_finite() => {
-                        let light_pdf = lights.pdf_li(SELECTION, previous_point, light, surface.p);
-                        self.hit_weight(previous_pdf, light_pdf)
-                    }
-                    _ => 1.0,
-                };
-                radiance += throughput * emitted * weight;
+            if let Some(light) = lights.light_of(hit.triangle) {
+                let emitted = lights.lights()[light as usize].radiance_towards(-ray.dir);
+                if emitted != Vec3::ZERO {
+                    let weight = if previous_pdf.is_finite() {
+                        self.hit_weight(previous_pdf, lights.pdf_li(SELECTION, light, ray.dir, hit.t))
+                    } else {
+                        1.0
+                    };
+                    radiance += throughput * emitted * weight;
+                }
             }
             depth += 1;
             if self.max_depth != 0 && depth >= self.max_depth {
                 break;
             }
 
+            let surface = world.surface(&ray, &hit);
             let bsdf = world.bsdf(&surface);
             // Opaque lobes scatter on the viewer's side, where `ns` is turned; a transmissive one
             // needs its own orientation (`wo.z < 0` means inside), so its frame keeps the normal's.
             let normal = if bsdf.transmits() && !surface.front_face { -surface.ns } else { surface.ns };
             let frame = Frame::from_normal(normal);
-            let wo = frame.to_local(-ray.dir.normalize());
+            let wo = frame.to_local(-ray.dir);
             let vertex = Vertex { surface: &surface, bsdf, frame, wo };
+            // Each vertex takes three dimensions, whether it uses them or not, so that a bounce's
+            // numbers do not depend on the vertices before it; a dimension not used is not computed.
+            let (light_point, scatter_point, survival) =
+                (ctx.stream.next_points(1), ctx.stream.next_points(1), ctx.stream.next_points(1));
 
             // Next-event estimation: one point on a light chosen by power (not through a delta lobe,
-            // which no light point can hit).
-            let (u_light, u_point) = (ctx.stream.next_1d(), ctx.stream.next_2d());
+            // which no light point can hit), both from one 2D point so that they stratify together.
             let sample = match self.strategy {
                 PathStrategy::BsdfOnly => None,
                 _ if bsdf.is_delta() => None,
-                _ => lights.sample_li(SELECTION, surface.p, u_light, u_point),
+                _ => lights.sample_li_reusing(SELECTION, surface.p, light_point.get_2d(0)),
             };
             if let Some(sample) = sample {
                 let (f_cos, local) = vertex.f_cos(sample.wi);
                 if f_cos != Vec3::ZERO {
                     ctx.rays += 1;
                     if !world.occluded(&surface.spawn_segment(sample.target)) {
-                        let weight = self.light_weight(sample.pdf, vertex.bsdf.pdf(wo, local));
-                        radiance += throughput * f_cos * sample.li * (weight / sample.pdf);
+                        let weight = self.light_weight_over_pdf(sample.pdf, vertex.bsdf.pdf(wo, local));
+                        radiance += throughput * f_cos * sample.li * weight;
                     }
                 }
             }
 
             // BSDF sampling: where the path goes next.
-            let Some(scattered) = vertex.bsdf.sample(wo, ctx.stream.next_2d()) else { break };
+            let Some(scattered) = vertex.bsdf.sample(wo, scatter_point.get_2d(0)) else { break };
             let wi = frame.to_world(scattered.wi);
             if !vertex.sides_agree(wi, scattered.wi) {
                 break;
@@ -174,14 +185,12 @@ impl Integrator for Path {
             throughput *= scattered.f * (scattered.wi.z.abs() / scattered.pdf);
             let specular = scattered.flags.contains(BsdfFlags::SPECULAR);
             previous_pdf = if specular { f32::INFINITY } else { scattered.pdf };
-            previous_point = surface.p;
             ray = surface.spawn_ray(wi);
 
             // Russian roulette, after `rr_depth` segments: survive with probability q, weigh by 1/q.
-            let u_survive = ctx.stream.next_1d();
             if depth >= self.rr_depth {
                 let q = throughput.max_element().min(0.95);
-                if q.is_nan() || u_survive >= q {
+                if q.is_nan() || survival.get_1d(0) >= q {
                     break;
                 }
                 throughput /= q;

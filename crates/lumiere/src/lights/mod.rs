@@ -11,7 +11,7 @@ use glam::{Vec2, Vec3};
 
 pub use area::AreaLight;
 
-use crate::sampling::distrib::AliasTable;
+use crate::sampling::distrib::{AliasTable, ONE_MINUS_EPSILON};
 use crate::sampling::warp::sample_uniform_triangle;
 use crate::scene::Scene;
 
@@ -86,16 +86,25 @@ impl LightSet {
     /// Chooses a light with `u` in `[0, 1)`: its index and the probability of that choice.
     #[inline]
     pub fn choose(&self, selection: LightSelection, u: f32) -> Option<(u32, f32)> {
+        self.choose_remapped(selection, u).map(|(index, pmf, _)| (index, pmf))
+    }
+
+    /// [`LightSet::choose`], and the part of `u` the choice left unused, rescaled to a uniform
+    /// number in `[0, 1)` (see [`AliasTable::sample_remapped`]).
+    #[inline]
+    fn choose_remapped(&self, selection: LightSelection, u: f32) -> Option<(u32, f32, f32)> {
         let n = self.lights.len();
         match selection {
             LightSelection::Uniform if n > 0 => {
-                let index = ((u * n as f32) as usize).min(n - 1);
-                Some((index as u32, 1.0 / n as f32))
+                let scaled = u * n as f32;
+                let index = (scaled as usize).min(n - 1);
+                let remapped = (scaled - index as f32).clamp(0.0, ONE_MINUS_EPSILON);
+                Some((index as u32, 1.0 / n as f32, remapped))
             }
             LightSelection::Uniform => None,
             LightSelection::Power => {
-                let choice = self.power.as_ref()?.sample(u);
-                Some((choice.index as u32, choice.pmf))
+                let (choice, remapped) = self.power.as_ref()?.sample_remapped(u);
+                Some((choice.index as u32, choice.pmf, remapped))
             }
         }
     }
@@ -115,6 +124,18 @@ impl LightSet {
     pub fn sample_li(&self, selection: LightSelection, p: Vec3, u_light: f32, u_point: Vec2) -> Option<LightSample> {
         let (index, pmf) = self.choose(selection, u_light)?;
         let mut sample = self.sample_li_on(index, p, u_point)?;
+        sample.pdf *= pmf;
+        Some(sample)
+    }
+
+    /// [`LightSet::sample_li`] from one 2D point: `u.x` chooses the light and, rescaled, places
+    /// the point on it with `u.y`. A stratified 2D pattern thus stays stratified over all the
+    /// lights together (over the two triangles of a quad light, say), which a separate number for
+    /// the choice would not give.
+    #[inline(always)]
+    pub fn sample_li_reusing(&self, selection: LightSelection, p: Vec3, u: Vec2) -> Option<LightSample> {
+        let (index, pmf, remapped) = self.choose_remapped(selection, u.x)?;
+        let mut sample = self.sample_li_on(index, p, Vec2::new(remapped, u.y))?;
         sample.pdf *= pmf;
         Some(sample)
     }
@@ -144,17 +165,17 @@ impl LightSet {
         Some(LightSample { li: light.emission, wi, dist, pdf, target, light: index })
     }
 
-    /// The solid-angle pdf with which [`LightSet::sample_li`] would have produced the point `y` of
-    /// light `index`, seen from `p`: what a BSDF-sampled ray that hits an emitter weighs against.
+    /// The solid-angle pdf with which [`LightSet::sample_li`] would have produced the point of light
+    /// `index` at distance `dist` along the unit direction `wi` from the receiver: what a
+    /// BSDF-sampled ray that hits an emitter weighs against (its hit distance is `dist`).
     #[inline]
-    pub fn pdf_li(&self, selection: LightSelection, p: Vec3, index: u32, y: Vec3) -> f32 {
+    pub fn pdf_li(&self, selection: LightSelection, index: u32, wi: Vec3, dist: f32) -> f32 {
         let light = &self.lights[index as usize];
-        let v = y - p;
-        let dist2 = v.length_squared();
-        let cos_light = -light.normal.dot(v) / dist2.sqrt();
-        if cos_light <= 0.0 || dist2 <= 0.0 {
+        let cos_light = -light.normal.dot(wi);
+        if cos_light <= 0.0 || dist <= 0.0 {
             return 0.0;
         }
-        self.choice_pmf(selection, index) * dist2 / (cos_light * light.area)
+        // Area measure 1/A to solid angle, as in `sample_li_on`.
+        self.choice_pmf(selection, index) * dist * dist / (cos_light * light.area)
     }
 }

@@ -8,6 +8,9 @@ pub struct DiscreteSample {
     pub pmf: f32,
 }
 
+/// The largest `f32` below 1.
+pub const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
+
 /// One bin of the alias table: keep the bin's own item with probability `threshold`, otherwise
 /// take `alias`.
 #[derive(Clone, Copy, Debug)]
@@ -55,14 +58,32 @@ impl AliasTable {
     /// `u` = 1 (or above) is clamped into the last bin rather than read out of range.
     #[inline]
     pub fn sample(&self, u: f32) -> DiscreteSample {
+        // Inlined, the unused remapped number (pure arithmetic) compiles away.
+        self.sample_remapped(u).0
+    }
+
+    /// [`AliasTable::sample`] and the part of `u` the choice did not use, rescaled to a fresh
+    /// uniform number in `[0, 1)`: within a bin, the values of `u` that pick one item form an
+    /// interval, mapped linearly onto `[0, 1)`. Reusing it lets one stratified 2D point both choose
+    /// an item and place a point on it (pbrt-v4's `SampleDiscrete` with `uRemapped`, Mitsuba's
+    /// `sample_reuse`), where a number of its own for the choice would leave the two stratified
+    /// apart only. The rescaled number keeps about `24 − log₂ n` bits of an `f32` sample's.
+    #[inline]
+    pub fn sample_remapped(&self, u: f32) -> (DiscreteSample, f32) {
         let n = self.bins.len();
         // f64: `u · n` is exact and stays below n for every f32 u < 1.
         let scaled = f64::from(u.max(0.0)) * n as f64;
         let bin = (scaled as usize).min(n - 1);
-        let fraction = (scaled - bin as f64) as f32;
+        let fraction = scaled - bin as f64;
         let Bin { threshold, alias } = self.bins[bin];
-        let index = if fraction < threshold { bin } else { alias as usize };
-        DiscreteSample { index, pmf: self.pmf[index] }
+        let t = f64::from(threshold);
+        let (index, remapped) = if (fraction as f32) < threshold {
+            (bin, fraction / t)
+        } else {
+            (alias as usize, (fraction - t) / (1.0 - t))
+        };
+        // Rounding of the f32 test can put `fraction` a hair on the other side of `t`.
+        (DiscreteSample { index, pmf: self.pmf[index] }, (remapped as f32).clamp(0.0, ONE_MINUS_EPSILON))
     }
 
     /// The probability of choosing `index` (its weight over the sum of weights).

@@ -313,6 +313,29 @@ fn alias_table_chi2() {
     }
 }
 
+/// The remapped number of `sample_remapped` is uniform on [0, 1) whatever item was chosen, and
+/// the choice is `sample`'s: (item, remapped number in 16 bins) follows `pmf(item) / 16`. A remap
+/// that leaked the choice into the number (or skewed it) fails here.
+#[test]
+fn alias_table_remapped_number_is_uniform_given_the_choice() {
+    const BINS: usize = 16;
+    for seed in [35, 36] {
+        let weights = weights_with_zeros(seed);
+        let table = AliasTable::new(&weights).unwrap();
+        let mut rng = TestRng(seed + 200);
+        let mut counts = vec![0u64; weights.len() * BINS];
+        for _ in 0..2_000_000 {
+            let u = rng.f32();
+            let (choice, remapped) = table.sample_remapped(u);
+            assert_eq!(choice, table.sample(u), "u {u}");
+            assert!((0.0..1.0).contains(&remapped), "u {u}: remapped {remapped}");
+            counts[choice.index * BINS + (remapped * BINS as f32) as usize] += 1;
+        }
+        let pmf: Vec<f64> = pmf_of(&weights).iter().flat_map(|&p| [p / BINS as f64; BINS]).collect();
+        assert_passes(&format!("alias table remap (weights seed {seed})"), chi2_discrete(&pmf, &counts));
+    }
+}
+
 #[test]
 fn alias_table_pmf_matches_weights_and_u_sweep() {
     let weights = weights_with_zeros(33);

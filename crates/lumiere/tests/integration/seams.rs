@@ -143,39 +143,86 @@ fn solid_angle(p: Vec3, [a, b, c]: [Vec3; 3]) -> f64 {
 }
 
 /// Light samples carry their density per unit solid angle, light choice included: `E[1/pdf]` is
-/// the solid angle the lights subtend (in closed form), for either selection; and every sample's
-/// `pdf` equals `pdf_li` at its point.
+/// the solid angle the lights subtend (in closed form), for either selection and whether the
+/// choice has a number of its own (`sample_li`) or reuses the point's (`sample_li_reusing`); and
+/// every sample's `pdf` equals `pdf_li` at its point.
 #[test]
 fn light_sample_pdfs_are_per_unit_solid_angle() {
     let lights = LightSet::new(&light_scene());
     let p = Vec3::new(0.2, 0.0, 0.1);
     let expected: f64 = lights.lights().iter().map(|l| solid_angle(p, l.vertices)).sum();
     for selection in [LightSelection::Uniform, LightSelection::Power] {
-        let mut rng = TestRng(7);
-        let n = 400_000;
-        let (mut sum, mut sum_sq) = (0.0f64, 0.0f64);
-        for _ in 0..n {
-            let u = Vec2::new(rng.f32(), rng.f32());
-            let s = lights.sample_li(selection, p, rng.f32(), u).expect("both lights face p");
-            let on_light = pdf_at(&lights, selection, p, s.light, s.wi, s.dist);
-            assert!((s.pdf - on_light).abs() <= 1e-3 * on_light, "{selection:?}: pdf {} vs pdf_li {on_light}", s.pdf);
-            let w = 1.0 / s.pdf as f64;
-            sum += w;
-            sum_sq += w * w;
+        for reusing in [false, true] {
+            let mut rng = TestRng(7);
+            let n = 400_000;
+            let (mut sum, mut sum_sq) = (0.0f64, 0.0f64);
+            for _ in 0..n {
+                let (u_light, u) = (rng.f32(), Vec2::new(rng.f32(), rng.f32()));
+                let s = if reusing {
+                    lights.sample_li_reusing(selection, p, u)
+                } else {
+                    lights.sample_li(selection, p, u_light, u)
+                };
+                let s = s.expect("both lights face p");
+                let on_light = pdf_at(&lights, selection, p, s.light, s.target);
+                assert!(
+                    (s.pdf - on_light).abs() <= 1e-3 * on_light,
+                    "{selection:?}: pdf {} vs pdf_li {on_light}",
+                    s.pdf
+                );
+                let w = 1.0 / s.pdf as f64;
+                sum += w;
+                sum_sq += w * w;
+            }
+            let mean = sum / n as f64;
+            let error = ((sum_sq / n as f64 - mean * mean) / n as f64).sqrt();
+            println!("{selection:?}, reusing {reusing}: E[1/pdf] = {mean} +- {error}, solid angle {expected}");
+            assert!(
+                (mean - expected).abs() < 4.0 * error,
+                "{selection:?}, reusing {reusing}: E[1/pdf] = {mean} +- {error}, expected {expected}"
+            );
         }
-        let mean = sum / n as f64;
-        let error = ((sum_sq / n as f64 - mean * mean) / n as f64).sqrt();
-        println!("{selection:?}: E[1/pdf] = {mean} +- {error}, solid angle {expected}");
-        assert!(
-            (mean - expected).abs() < 4.0 * error,
-            "{selection:?}: E[1/pdf] = {mean} +- {error}, expected {expected}"
-        );
     }
 }
 
-/// `pdf_li` at the point a sample's direction and distance lead to.
-fn pdf_at(lights: &LightSet, selection: LightSelection, p: Vec3, light: u32, wi: Vec3, dist: f32) -> f32 {
-    lights.pdf_li(selection, p, light, p + wi * dist)
+/// With the choice reusing the point's number, the points still fall uniformly on each light:
+/// the barycentric parameters (`invert_uniform_triangle_sample`) of the points on either light
+/// are uniform on the square, and each light is chosen as often as `choice_pmf` says.
+#[test]
+fn reused_light_choice_leaves_the_points_uniform_on_each_light() {
+    use lumiere::sampling::warp::invert_uniform_triangle_sample;
+    let lights = LightSet::new(&light_scene());
+    let p = Vec3::new(0.2, 0.0, 0.1);
+    for selection in [LightSelection::Uniform, LightSelection::Power] {
+        let mut rng = TestRng(9);
+        let mut points = [Vec::new(), Vec::new()];
+        for _ in 0..400_000 {
+            let s = lights.sample_li_reusing(selection, p, Vec2::new(rng.f32(), rng.f32())).unwrap();
+            let [a, b, c] = lights.lights()[s.light as usize].shadow_targets;
+            points[s.light as usize].push(invert_uniform_triangle_sample(barycentrics(s.target, a, b, c)));
+        }
+        let counts = [points[0].len() as u64, points[1].len() as u64];
+        let pmf = [0, 1].map(|i| lights.choice_pmf(selection, i) as f64);
+        assert_passes(&format!("{selection:?}: choice"), chi2_discrete(&pmf, &counts));
+        for (light, on_light) in points.into_iter().enumerate() {
+            let result = Chi2Test::new(16, 16).run_points(on_light.into_iter().map(Some), |_| 1.0);
+            assert_passes(&format!("{selection:?}: points on light {light}"), result);
+        }
+    }
+}
+
+/// The barycentric coordinates of `y` (on the triangle's plane) in `[a, b, c]`.
+fn barycentrics(y: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
+    let (y, a, b, c) = (y.as_dvec3(), a.as_dvec3(), b.as_dvec3(), c.as_dvec3());
+    let n = (b - a).cross(c - a);
+    let area = n.length_squared();
+    let (wb, wc) = ((y - a).cross(c - a).dot(n) / area, (b - a).cross(y - a).dot(n) / area);
+    Vec3::new((1.0 - wb - wc) as f32, wb as f32, wc as f32)
+}
+
+/// `pdf_li` at the point `y` of `light`, seen from `p`.
+fn pdf_at(lights: &LightSet, selection: LightSelection, p: Vec3, light: u32, y: Vec3) -> f32 {
+    lights.pdf_li(selection, light, (y - p).normalize(), p.distance(y))
 }
 
 /// A light seen from behind gives no sample: emission is one-sided.
@@ -186,7 +233,7 @@ fn lights_do_not_emit_backwards() {
     for k in 0..100 {
         let u = Vec2::new(k as f32 / 100.0, 0.37);
         assert!(lights.sample_li_on(0, above, u).is_none());
-        assert_eq!(lights.pdf_li(LightSelection::Uniform, above, 0, Vec3::new(0.0, 2.0, 0.0)), 0.0);
+        assert_eq!(pdf_at(&lights, LightSelection::Uniform, above, 0, Vec3::new(0.0, 2.0, 0.0)), 0.0);
     }
 }
 

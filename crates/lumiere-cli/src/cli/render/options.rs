@@ -26,8 +26,13 @@ pub fn from_args(args: &RenderArgs) -> RenderOptions {
         spp,
         seed: args.seed,
         sampler: match args.sampler {
-            SamplerArg::Independent => SamplerKind::Independent,
-            SamplerArg::Sobol => SamplerKind::Sobol,
+            Some(SamplerArg::Independent) => SamplerKind::Independent,
+            Some(SamplerArg::Sobol) => SamplerKind::Sobol,
+            // Path tracing draws a few well-stratified 2D dimensions per bounce, where Sobol's
+            // error is about half the independent sampler's at 64 spp (BENCHMARKS.md); the lab's
+            // modes keep the independent numbers their images were recorded with.
+            None if args.mode == ModeArg::Path => SamplerKind::Sobol,
+            None => SamplerKind::Independent,
         },
         time_budget: args.time,
         noise_target: args.noise,

@@ -122,7 +122,7 @@ def render_full(
     spp: int = 64,
     seed: int = 0,
     *,
-    sampler: str = "independent",
+    sampler: Optional[str] = None,
     size: Optional[Tuple[int, int]] = None,
     address: Optional[str] = "auto",
     tasks: Optional[int] = None,
@@ -143,7 +143,7 @@ def render_full(
     for name, value, least in (("tasks", tasks, 1), ("threads_per_task", threads_per_task, 1), ("max_retries", max_retries, 0)):
         if value is not None and (not isinstance(value, int) or value < least):
             raise LumiereError(f"{name} must be an integer of at least {least}, got {value!r}")
-    option_args = dict(mode=str(mode), spp=spp, seed=seed, sampler=str(sampler), **technique_options)
+    option_args = dict(mode=str(mode), spp=spp, seed=seed, sampler=None if sampler is None else str(sampler), **technique_options)
     options = _options(mode, spp, seed, sampler, None, None, technique_options)
     camera = _camera(scene, camera, size)
     width, height = camera.size
@@ -218,7 +218,7 @@ def render(
     spp: int = 64,
     seed: int = 0,
     *,
-    sampler: str = "independent",
+    sampler: Optional[str] = None,
     size: Optional[Tuple[int, int]] = None,
     address: Optional[str] = "auto",
     tasks: Optional[int] = None,

@@ -48,7 +48,7 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--mode", default="path", choices=["path", "hits", "materials", "shadows", "direct", "ao"])
     p.add_argument("--spp", type=int, default=None, help="camera samples per pixel (default 8 for path, 1 otherwise)")
     p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--sampler", default="independent", choices=["independent", "sobol"])
+    p.add_argument("--sampler", choices=["independent", "sobol"], help="default sobol for path, independent otherwise")
     p.add_argument("--size", type=_size, default=(1024, 768), help="WIDTHxHEIGHT (default 1024x768)")
     p.add_argument("--samples", type=int, help="direct and ao: points per light or directions (default 16)")
     p.add_argument("--light-sampling", choices=["per-light", "power"])
