@@ -1,4 +1,4 @@
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 use super::{Integrator, SampleContext, shading_frame};
 use crate::accel::{OriginBatch, Region};
@@ -42,10 +42,10 @@ impl<B: Bsdf> Receiver<'_, B> {
     /// contribute (below the surface, or a zero BSDF), so that no shadow ray is traced for it.
     #[inline(always)]
     fn unshadowed(&self, sample: &LightSample) -> Option<Vec3> {
-        let cos_surface = self.surface.ns.dot(sample.wi);
-        if cos_surface <= 0.0 || self.surface.ng.dot(sample.wi) <= 0.0 {
+        if !self.faces(sample) {
             return None;
         }
+        let cos_surface = self.surface.ns.dot(sample.wi);
         let f = self.bsdf.eval(self.wo, self.frame.to_local(sample.wi));
         (f != Vec3::ZERO).then(|| f * sample.li * (cos_surface / sample.pdf))
     }
@@ -79,16 +79,22 @@ impl<B: Bsdf> Receiver<'_, B> {
                 break;
             }
             let count = (n - first).min(LANES as u32) as usize;
+            // Three loops, so that the middle one, plain arithmetic, is vectorised: the sampler
+            // and the BSDF are calls per lane, which would keep it scalar if they sat in it.
+            let points: [Vec2; LANES] = std::array::from_fn(|lane| points.get_2d(first + lane as u32));
+            let mut samples = [None; LANES];
+            for (sample, u) in samples.iter_mut().zip(points) {
+                *sample = lights.sample_li_on(light, self.surface.p, u).filter(|s| self.faces(s));
+            }
             let mut contributions = [Vec3::ZERO; LANES];
             let mut segments = [[0.0; LANES]; 3];
             let mut traced = 0u32;
-            for lane in 0..count {
-                let u = points.get_2d(first + lane as u32);
-                let Some(sample) = lights.sample_li_on(light, self.surface.p, u) else { continue };
-                let Some(contribution) = self.unshadowed(&sample) else { continue };
+            for (lane, sample) in samples.iter().enumerate().take(count) {
+                let Some(contribution) = sample.as_ref().and_then(|s| self.unshadowed(s)) else { continue };
                 contributions[lane] = contribution;
                 // `Ray::segment(origin, target)`: the direction is the whole segment, tmax 1.
-                [segments[0][lane], segments[1][lane], segments[2][lane]] = (sample.target - origin).to_array();
+                let segment = sample.as_ref().map_or(Vec3::ZERO, |s| s.target - origin);
+                [segments[0][lane], segments[1][lane], segments[2][lane]] = segment.to_array();
                 traced |= 1 << lane;
             }
             ctx.rays += u64::from(traced.count_ones());
@@ -100,6 +106,15 @@ impl<B: Bsdf> Receiver<'_, B> {
             }
         }
         sum
+    }
+}
+
+impl<B> Receiver<'_, B> {
+    /// Whether the light sample may arrive from above the surface, by both normals (a NaN passes:
+    /// its contribution is counted as discarded, as every non-finite sample is).
+    #[inline(always)]
+    fn faces(&self, sample: &LightSample) -> bool {
+        !(self.surface.ns.dot(sample.wi) <= 0.0 || self.surface.ng.dot(sample.wi) <= 0.0)
     }
 }
 
