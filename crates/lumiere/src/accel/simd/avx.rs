@@ -1,9 +1,10 @@
 //! Eight f32 lanes in one 256-bit register, for the 8-wide BVH on CPUs with AVX2 or AVX-512.
 //!
-//! One kernel, two levels: the same operations compiled with AVX2 enabled, or with AVX-512 (F, VL)
-//! enabled, where the compiler gets 32 vector registers and mask registers for the comparisons.
-//! Both round exactly alike (Rust never fuses a multiply and an add on its own), so they return
-//! the same bits as the SSE and scalar paths.
+//! One kernel, generic in the level it is compiled for: AVX2, or AVX-512 (F, VL, DQ), where the
+//! compiler gets 32 vector registers and mask registers. Every level rounds exactly alike (Rust
+//! never fuses a multiply and an add on its own), so they return the same bits as the SSE and
+//! scalar paths. The BVH traversal runs at the AVX2 level on both AVX ISAs (see `Accel`); the
+//! AVX-512 level runs the 16-lane loops of `Accel::simd`.
 //!
 //! Unlike SSE, neither is part of the x86-64 baseline: these intrinsics may only run on a CPU that
 //! has the level's features. The kernel's operations run only through [`Lanes::dispatch`] on a

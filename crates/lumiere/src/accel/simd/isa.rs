@@ -12,7 +12,7 @@ pub enum Isa {
     Sse2,
     /// AVX2: the 8-wide BVH with 256-bit kernels.
     Avx2,
-    /// AVX-512 F, VL and DQ: the 8-wide BVH compiled with AVX-512's registers and masks.
+    /// AVX-512 F, VL and DQ: the 8-wide BVH (traversed with the AVX2 kernel) and 16-lane loops.
     Avx512,
 }
 
@@ -30,13 +30,12 @@ impl Isa {
     pub fn is_supported(self) -> bool {
         #[cfg(target_arch = "x86_64")]
         {
-            use super::Lanes;
-            use super::avx::{Avx2, Avx512, F32x8};
+            use super::avx::{Avx2, Avx512, AvxLevel};
             match self {
                 // The portable kernel runs anywhere; on x86-64 it is for tests, as SSE2 is always there.
                 Isa::Portable | Isa::Sse2 => true,
-                Isa::Avx2 => F32x8::<Avx2>::supported(),
-                Isa::Avx512 => F32x8::<Avx512>::supported(),
+                Isa::Avx2 => Avx2::supported(),
+                Isa::Avx512 => Avx512::supported(),
             }
         }
         #[cfg(not(target_arch = "x86_64"))]
