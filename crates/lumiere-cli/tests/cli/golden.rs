@@ -77,7 +77,7 @@ const CASES: [Case; 11] = [
             0x3eb8316883e5fef2,
         ),
         ("path", &["--mode", "path", "--spp", "2", "--max-depth", "5"], 0x80c5df54f8762710, 0x4e36eaaea82bfa93),
-        // Enough rays per origin for shared-origin batches (below 8 per shaft or 32 per hemisphere
+        // Enough rays per origin for shared-origin batches (below 8 per shaft or 16 per hemisphere
         // each ray is traversed alone): recorded before the ray-major batch kernels.
         ("ao-batch", &["--mode", "ao", "--samples", "40"], 0x3408fd741b8ed1f4, 0xf51ab36181dcf809),
         ("ao-batch-near", &["--mode", "ao", "--samples", "33", "--spp", "2", "--ao-distance", "0.3"], 0x5ffe4e98288a909c, 0xdaa33abb590eab16),
