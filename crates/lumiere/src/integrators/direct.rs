@@ -79,8 +79,9 @@ impl<B: Bsdf> Receiver<'_, B> {
                 break;
             }
             let count = (n - first).min(LANES as u32) as usize;
-            // Three loops, so that the middle one, plain arithmetic, is vectorised: the sampler
-            // and the BSDF are calls per lane, which would keep it scalar if they sat in it.
+            // Three loops: the random numbers, the light points (plain arithmetic, vectorised),
+            // then the BSDF. The sampler and the BSDF are calls per lane, which would keep the
+            // light points scalar if they sat in the same loop.
             let points: [Vec2; LANES] = std::array::from_fn(|lane| points.get_2d(first + lane as u32));
             let mut samples = [None; LANES];
             for (sample, u) in samples.iter_mut().zip(points) {
@@ -90,11 +91,11 @@ impl<B: Bsdf> Receiver<'_, B> {
             let mut segments = [[0.0; LANES]; 3];
             let mut traced = 0u32;
             for (lane, sample) in samples.iter().enumerate().take(count) {
-                let Some(contribution) = sample.as_ref().and_then(|s| self.unshadowed(s)) else { continue };
+                let Some(sample) = sample else { continue };
+                let Some(contribution) = self.unshadowed(sample) else { continue };
                 contributions[lane] = contribution;
                 // `Ray::segment(origin, target)`: the direction is the whole segment, tmax 1.
-                let segment = sample.as_ref().map_or(Vec3::ZERO, |s| s.target - origin);
-                [segments[0][lane], segments[1][lane], segments[2][lane]] = segment.to_array();
+                [segments[0][lane], segments[1][lane], segments[2][lane]] = (sample.target - origin).to_array();
                 traced |= 1 << lane;
             }
             ctx.rays += u64::from(traced.count_ones());
