@@ -107,7 +107,8 @@ impl World {
         self.accel.occluded(ray)
     }
 
-    /// Readies `batch` for many rays leaving `origin` inside `region` (see [`OriginBatch`]).
+    /// Readies `batch` for `rays` rays leaving `origin` inside `region`: gathers their candidate
+    /// triangles, or notes that they are cheaper traced one by one (see [`OriginBatch`]).
     #[inline]
     pub fn prepare_batch(&self, batch: &mut OriginBatch, origin: Vec3, region: &Region, rays: u32) {
         self.accel.prepare_batch(batch, origin, region, rays);

@@ -121,7 +121,8 @@ impl Accel {
         with_bvh!(self, bvh => bvh.occluded_counted(ray, stats))
     }
 
-    /// Readies `batch` for many rays leaving `origin` inside `region` (see [`OriginBatch`]).
+    /// Readies `batch` for `rays` rays leaving `origin` inside `region`: gathers their candidate
+    /// triangles, or notes that they are cheaper traced one by one (see [`OriginBatch`]).
     #[inline]
     pub fn prepare_batch(&self, batch: &mut OriginBatch, origin: Vec3, region: &Region, rays: u32) {
         with_bvh!(self, bvh => batch.prepare(bvh, origin, region, rays))
