@@ -62,9 +62,8 @@ impl AmbientOcclusion {
             if ctx.must_stop(first + LANES as u32 - 1) {
                 break;
             }
-            // The random numbers first: the sampler is a call per point, which would keep the
-            // warp below from being vectorised if it sat in the same loop.
-            let points: [Vec2; LANES] = std::array::from_fn(|lane| directions.get_2d(first + lane as u32));
+            // The random numbers first, then the warp, each in its own vectorisable loop.
+            let points: [Vec2; LANES] = directions.get_2d_lanes(first);
             let mut dirs = [[0.0; LANES]; 3];
             for lane in 0..LANES {
                 let dir = frame.to_world(sample_cosine_hemisphere(points[lane]));

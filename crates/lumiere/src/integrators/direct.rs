@@ -79,10 +79,10 @@ impl<B: Bsdf> Receiver<'_, B> {
                 break;
             }
             let count = (n - first).min(LANES as u32) as usize;
-            // Three loops: the random numbers, the light points (plain arithmetic, vectorised),
-            // then the BSDF. The sampler and the BSDF are calls per lane, which would keep the
-            // light points scalar if they sat in the same loop.
-            let points: [Vec2; LANES] = std::array::from_fn(|lane| points.get_2d(first + lane as u32));
+            // Three loops: the random numbers, the light points (plain arithmetic; both
+            // vectorised), then the BSDF, a call per lane, which would keep the others scalar if
+            // they shared its loop.
+            let points: [Vec2; LANES] = points.get_2d_lanes(first);
             let mut samples = [None; LANES];
             for (sample, u) in samples.iter_mut().zip(points) {
                 *sample = lights.sample_li_on(light, self.surface.p, u).filter(|s| self.faces(s));
