@@ -2,6 +2,7 @@
 //! has. Forcing one is for tests and benchmarks: every ISA gives the same image bytes.
 
 use lumiere::accel::Isa;
+use lumiere::error::quote;
 use lumiere::{Error, Result};
 
 /// The environment variable that forces an ISA when `--isa` is absent.
@@ -9,8 +10,8 @@ const ENV: &str = "LUMIERE_ISA";
 
 /// An ISA by name, refused unless this CPU can run it.
 pub fn parse(name: &str) -> std::result::Result<Isa, String> {
-    let isa =
-        Isa::from_name(name.trim()).ok_or_else(|| format!("unknown ISA {name:?} (expected {})", names(&Isa::ALL)))?;
+    let isa = Isa::from_name(name.trim())
+        .ok_or_else(|| format!("unknown ISA {} (expected {})", quote(name), names(&Isa::ALL)))?;
     if !isa.is_supported() {
         return Err(format!("this CPU cannot run {isa} (it can run {})", names(&Isa::supported())));
     }

@@ -287,6 +287,11 @@ fn isa_environment_variable_is_honoured_and_checked() {
     assert_eq!(refused.status.code(), Some(2));
     assert!(stderr(&refused).contains("LUMIERE_ISA: unknown ISA"), "{}", stderr(&refused));
     assert!(!out.exists());
+    // A huge value is quoted cut short, on one line.
+    let huge = run(&"a".repeat(100_000), &[]);
+    assert_eq!(huge.status.code(), Some(2));
+    let message = stderr(&huge);
+    assert!(message.len() < 400 && message.lines().count() == 1 && message.contains("(100000 bytes)"), "{message}");
 }
 
 #[test]

@@ -5,16 +5,19 @@
 //! origin to the light triangle, or the half-space above the surface) to gather the few triangles
 //! that can block any ray of the batch. For each of them the Plücker edge vectors
 //! `(vi - o) x (vj - o)` are precomputed; a ray `o + t d` then crosses the triangle iff the three
-//! `d . edge` share a sign, and the distance needs one more dot product. Per ray that is four dot
-//! products per triangle, four triangles per SSE operation, and no traversal at all.
+//! `d . edge` share a sign, and the distance needs one more dot product: four dot products per
+//! ray and triangle, and no traversal at all. `occluded` tests one ray against four triangles per
+//! SSE operation; `occluded_lanes` (what the integrators use) tests each triangle against up to 32
+//! rays at once, ray-major, with the same operations, so both give the same answers.
 //!
 //! The walk is generic in the BVH's width and kernel; the candidates are repacked four to a
-//! Plücker block whatever that width, and tested with the four-lane kernel.
+//! Plücker block whatever that width.
 //!
 //! Watertight like the Woop test: the two triangles sharing an edge compute its vector from the
 //! same two corner vectors in swapped order, so one is exactly the negation of the other and a ray
-//! through the edge is accepted by at least one of them. When the region holds too many triangles
-//! (large scenes, wide hemispheres), the batch falls back to ordinary traversal for each ray.
+//! through the edge is accepted by at least one of them. When gathering will not pay (too few
+//! rays per origin, a hemisphere in a large scene) or the region holds too many triangles, the
+//! batch falls back to ordinary traversal for each ray.
 
 use std::mem::MaybeUninit;
 
