@@ -17,6 +17,7 @@
 //! Then the batched `ao` and `direct` cases joined (issue 11, before their ray-major kernels).
 
 use std::process::Command;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use lumiere::accel::Isa;
 
@@ -33,7 +34,11 @@ fn hashes(name: &str, args: &[&str]) -> (u64, u64) {
 /// Renders with `scene_args` (a size, perhaps a scene file) and `args` to `.pfm` and `.png`;
 /// returns both files' hashes.
 fn hashes_of(name: &str, scene_args: &[&str], args: &[&str]) -> (u64, u64) {
-    let dir = std::env::temp_dir().join(format!("lumiere-golden-{name}-{}", std::process::id()));
+    // Tests run in parallel threads of one process and render the same cases: a counter keeps
+    // their folders apart (one test removing its folder must not pull another's files away).
+    static RENDERS: AtomicUsize = AtomicUsize::new(0);
+    let render = RENDERS.fetch_add(1, Ordering::Relaxed);
+    let dir = std::env::temp_dir().join(format!("lumiere-golden-{name}-{}-{render}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let digest = |extension: &str| {
         let out = dir.join(format!("{name}.{extension}"));
