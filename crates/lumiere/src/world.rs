@@ -101,6 +101,20 @@ impl World {
         self.accel.intersect(ray)
     }
 
+    /// [`World::intersect`] for the `live` rays among `N` (bit `i` for ray `i`), traced together
+    /// where they are coherent (see [`Accel::intersect_packet`]); the same hits.
+    #[inline]
+    pub fn intersect_packet<const N: usize>(&self, rays: &[Ray; N], live: u32) -> [Option<Hit>; N] {
+        self.accel.intersect_packet(rays, live)
+    }
+
+    /// [`World::occluded`] for the `live` rays among `N`, traced together where they are coherent;
+    /// bit `i` set if ray `i` is blocked.
+    #[inline]
+    pub fn occluded_packet<const N: usize>(&self, rays: &[Ray; N], live: u32) -> u32 {
+        self.accel.occluded_packet(rays, live)
+    }
+
     /// Whether anything lies along `ray` within `[0, ray.tmax]`.
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {

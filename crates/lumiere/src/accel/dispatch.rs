@@ -9,9 +9,13 @@ use glam::Vec3;
 
 use super::bvh2::{BuildPreset, Bvh};
 use super::simd::portable::F32xN;
-use super::wide::WideBvh;
+use super::wide::{PacketKey, RayPacket, WideBvh};
 use super::{Bvh4, Hit, Isa, OriginBatch, Region, TraversalStats};
 use crate::math::Ray;
+
+/// Fewer rays than this sharing a [`PacketKey`] are traced one by one: a packet's walk costs about
+/// what its widest lane's does, so a handful of rays do not pay for it.
+const MIN_PACKET_RAYS: u32 = 4;
 
 /// A BVH built for one instruction set.
 #[derive(Clone, Debug)]
@@ -178,4 +182,84 @@ impl Accel {
     pub fn occluded_in_batch(&self, batch: &OriginBatch, ray: &Ray) -> bool {
         with_bvh!(self, bvh => batch.occluded(bvh, ray))
     }
+
+    /// The closest hits of the `live` rays among `N` (bit `i` for ray `i`; `None` elsewhere), as
+    /// [`Accel::intersect`] returns them, traced together: rays that share a [`PacketKey`] (most
+    /// of a block of camera rays, or of their shadow rays towards one point) walk the BVH as one
+    /// packet, ray-major in this accel's ISA, and the few others alone.
+    #[inline(always)]
+    pub fn intersect_packet<const N: usize>(&self, rays: &[Ray; N], live: u32) -> [Option<Hit>; N] {
+        let mut hits = [None; N];
+        let alone = self.for_each_packet(
+            rays,
+            live,
+            #[inline(always)]
+            |packet, lanes| {
+                let found = with_bvh!(self, bvh => bvh.intersect_packet(packet));
+                for lane in lanes_of(lanes) {
+                    hits[lane] = found[lane];
+                }
+            },
+        );
+        for lane in lanes_of(alone) {
+            hits[lane] = self.intersect(&rays[lane]);
+        }
+        hits
+    }
+
+    /// Which of the `live` rays among `N` are blocked (bit `i` for ray `i`), as [`Accel::occluded`]
+    /// answers each, traced together as in [`Accel::intersect_packet`].
+    #[inline(always)]
+    pub fn occluded_packet<const N: usize>(&self, rays: &[Ray; N], live: u32) -> u32 {
+        let mut blocked = 0;
+        let alone = self.for_each_packet(
+            rays,
+            live,
+            #[inline(always)]
+            |packet, lanes| blocked |= with_bvh!(self, bvh => bvh.occluded_packet(packet, lanes)) & lanes,
+        );
+        for lane in lanes_of(alone) {
+            blocked |= u32::from(self.occluded(&rays[lane])) << lane;
+        }
+        blocked
+    }
+
+    /// Splits the `live` rays into groups sharing a key and calls `packet` with each group of at
+    /// least `MIN_PACKET_RAYS` (and the group's lanes; the other lanes repeat one of its rays).
+    /// Returns the lanes left to trace alone.
+    #[inline(always)]
+    fn for_each_packet<const N: usize>(
+        &self,
+        rays: &[Ray; N],
+        live: u32,
+        mut packet: impl FnMut(&RayPacket<N>, u32),
+    ) -> u32 {
+        let keys: [PacketKey; N] = std::array::from_fn(|lane| PacketKey::of(&rays[lane]));
+        let mut alone = 0;
+        let mut remaining = live;
+        while remaining != 0 {
+            let first = remaining.trailing_zeros() as usize;
+            let key = keys[first];
+            let group = (0..N).fold(0u32, |m, lane| m | u32::from(keys[lane] == key) << lane) & remaining;
+            remaining &= !group;
+            if group.count_ones() < MIN_PACKET_RAYS || key == PacketKey::ALONE {
+                alone |= group;
+                continue;
+            }
+            // Lanes outside the group carry the group's first ray, so that every lane shares the key.
+            let members: [Ray; N] =
+                std::array::from_fn(|lane| rays[if group & (1 << lane) != 0 { lane } else { first }]);
+            self.simd(
+                #[inline(always)]
+                || packet(&RayPacket::new(key, &members), group),
+            );
+        }
+        alone
+    }
+}
+
+/// The lanes whose bits are set in `mask`, in increasing order.
+#[inline(always)]
+fn lanes_of(mask: u32) -> impl Iterator<Item = usize> {
+    (0..32).filter(move |lane| mask & (1 << lane) != 0)
 }

@@ -25,14 +25,7 @@ pub struct WatertightRay {
 impl WatertightRay {
     pub fn new(ray: &Ray) -> Self {
         let d = ray.dir;
-        let abs = d.abs();
-        let kz = if abs.x >= abs.y && abs.x >= abs.z {
-            0
-        } else if abs.y >= abs.z {
-            1
-        } else {
-            2
-        };
+        let kz = dominant_axis(d);
         let mut kx = (kz + 1) % 3;
         let mut ky = (kx + 1) % 3;
         // Keep the winding: if the dominant direction is negative, swap x and y.
@@ -40,6 +33,20 @@ impl WatertightRay {
             std::mem::swap(&mut kx, &mut ky);
         }
         WatertightRay { origin: ray.origin, kx, ky, kz, sx: d[kx] / d[kz], sy: d[ky] / d[kz], sz: 1.0 / d[kz] }
+    }
+}
+
+/// The axis of the largest component of `d` in magnitude (the first of equals), which the
+/// watertight test turns into its z axis.
+#[inline(always)]
+pub fn dominant_axis(d: Vec3) -> usize {
+    let abs = d.abs();
+    if abs.x >= abs.y && abs.x >= abs.z {
+        0
+    } else if abs.y >= abs.z {
+        1
+    } else {
+        2
     }
 }
 

@@ -1,6 +1,7 @@
 use glam::{Vec2, Vec3};
 
-use super::{Integrator, SampleContext};
+use super::{SampleContext, ShadesClosestHit};
+use crate::accel::Hit;
 use crate::accel::{OriginBatch, Region};
 use crate::math::{Frame, Ray};
 use crate::sampler::PointSet;
@@ -22,10 +23,9 @@ pub struct AmbientOcclusion {
 /// Probes drawn and tested together: one AVX-512 register of f32 (two AVX2 ones).
 const LANES: usize = 16;
 
-impl Integrator for AmbientOcclusion {
-    fn radiance(&self, world: &World, ray: &Ray, ctx: &mut SampleContext) -> Vec3 {
-        ctx.rays += 1;
-        let Some(hit) = world.intersect(ray) else { return Vec3::ZERO };
+impl ShadesClosestHit for AmbientOcclusion {
+    fn shade(&self, world: &World, ray: &Ray, hit: Option<Hit>, ctx: &mut SampleContext) -> Vec3 {
+        let Some(hit) = hit else { return Vec3::ZERO };
         let surface = world.surface(ray, &hit);
         let frame = Frame::from_normal(surface.ng);
         let directions = ctx.stream.next_points(self.samples);

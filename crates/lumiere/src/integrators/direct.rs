@@ -1,7 +1,7 @@
 use glam::{Vec2, Vec3};
 
-use super::{Integrator, SampleContext, shading_frame};
-use crate::accel::{OriginBatch, Region};
+use super::{SampleContext, ShadesClosestHit, shading_frame};
+use crate::accel::{Hit, OriginBatch, Region};
 use crate::geometry::surface::SurfacePoint;
 use crate::lights::{AreaLight, LightSample, LightSelection};
 use crate::materials::Bsdf;
@@ -127,10 +127,9 @@ fn faces_each_other(surface: &SurfacePoint, light: &AreaLight) -> bool {
     above && in_front
 }
 
-impl Integrator for Direct {
-    fn radiance(&self, world: &World, ray: &Ray, ctx: &mut SampleContext) -> Vec3 {
-        ctx.rays += 1;
-        let Some(hit) = world.intersect(ray) else { return Vec3::ZERO };
+impl ShadesClosestHit for Direct {
+    fn shade(&self, world: &World, ray: &Ray, hit: Option<Hit>, ctx: &mut SampleContext) -> Vec3 {
+        let Some(hit) = hit else { return Vec3::ZERO };
         // A light seen from the side it faces shows its emission; from behind it is a surface.
         let emitted = world.emitted(hit.triangle, ray);
         if emitted != Vec3::ZERO {

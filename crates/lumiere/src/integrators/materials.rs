@@ -1,6 +1,7 @@
 use glam::Vec3;
 
-use super::{Integrator, SampleContext};
+use super::{SampleContext, ShadesClosestHit};
+use crate::accel::Hit;
 use crate::materials::Bsdf;
 use crate::math::Ray;
 use crate::world::World;
@@ -9,9 +10,8 @@ use crate::world::World;
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Materials;
 
-impl Integrator for Materials {
-    fn radiance(&self, world: &World, ray: &Ray, ctx: &mut SampleContext) -> Vec3 {
-        ctx.rays += 1;
-        world.intersect(ray).map_or(Vec3::ZERO, |hit| world.bsdf(&world.surface(ray, &hit)).albedo())
+impl ShadesClosestHit for Materials {
+    fn shade(&self, world: &World, ray: &Ray, hit: Option<Hit>, _: &mut SampleContext) -> Vec3 {
+        hit.map_or(Vec3::ZERO, |hit| world.bsdf(&world.surface(ray, &hit)).albedo())
     }
 }

@@ -10,7 +10,7 @@ mod shadows;
 
 use glam::Vec3;
 
-use crate::accel::OriginBatch;
+use crate::accel::{Hit, OriginBatch};
 use crate::error::{Error, Result};
 use crate::math::{Frame, Ray};
 use crate::sampler::SampleStream;
@@ -104,10 +104,77 @@ impl SampleContext<'_> {
     }
 }
 
+/// Pixels shaded together: a block of 4x4, whose camera rays are traced as a packet.
+pub const PACKET: usize = 16;
+
+/// The camera samples of up to [`PACKET`] pixels: lane `i` has a ray and its sample's random numbers
+/// if bit `i` of `live` is set (the other lanes repeat a live one and are never shaded).
+pub struct CameraPacket<'a> {
+    pub rays: [Ray; PACKET],
+    pub streams: [SampleStream<'a>; PACKET],
+    pub live: u32,
+}
+
+impl CameraPacket<'_> {
+    /// The live lanes, in order.
+    pub fn lanes(&self) -> impl Iterator<Item = usize> + use<> {
+        let live = self.live;
+        (0..PACKET).filter(move |lane| live & (1 << lane) != 0)
+    }
+}
+
 /// Radiance along a camera ray. Implemented by plain structs and used through generics, so the
 /// per-ray path has no dynamic dispatch.
 pub trait Integrator: Sync {
     fn radiance(&self, world: &World, ray: &Ray, ctx: &mut SampleContext) -> Vec3;
+
+    /// The radiance of every live lane of `camera` (zero elsewhere): exactly what
+    /// [`Integrator::radiance`] returns for each, with each lane's stream. One by one unless the
+    /// integrator traces the packet's rays together.
+    fn radiance_packet<'a>(
+        &self,
+        world: &World,
+        camera: &CameraPacket<'a>,
+        ctx: &mut SampleContext<'a>,
+    ) -> [Vec3; PACKET] {
+        let mut radiance = [Vec3::ZERO; PACKET];
+        for lane in camera.lanes() {
+            ctx.stream = camera.streams[lane];
+            radiance[lane] = self.radiance(world, &camera.rays[lane], ctx);
+        }
+        radiance
+    }
+}
+
+/// An integrator whose radiance is a function of the camera ray's closest hit: it gets
+/// [`Integrator`] from this, with the hits of a packet's camera rays found together
+/// ([`World::intersect_packet`]).
+pub trait ShadesClosestHit: Sync {
+    /// The radiance along the camera ray `ray`, whose closest hit is `hit` (the ray is counted).
+    fn shade(&self, world: &World, ray: &Ray, hit: Option<Hit>, ctx: &mut SampleContext) -> Vec3;
+}
+
+impl<T: ShadesClosestHit> Integrator for T {
+    fn radiance(&self, world: &World, ray: &Ray, ctx: &mut SampleContext) -> Vec3 {
+        ctx.rays += 1;
+        self.shade(world, ray, world.intersect(ray), ctx)
+    }
+
+    fn radiance_packet<'a>(
+        &self,
+        world: &World,
+        camera: &CameraPacket<'a>,
+        ctx: &mut SampleContext<'a>,
+    ) -> [Vec3; PACKET] {
+        let hits = world.intersect_packet(&camera.rays, camera.live);
+        let mut radiance = [Vec3::ZERO; PACKET];
+        for lane in camera.lanes() {
+            ctx.stream = camera.streams[lane];
+            ctx.rays += 1;
+            radiance[lane] = self.shade(world, &camera.rays[lane], hits[lane], ctx);
+        }
+        radiance
+    }
 }
 
 /// The shading frame at a surface (`z` = the shading normal) and the direction towards the viewer

@@ -103,6 +103,78 @@ fn check_against_brute_force(positions: &[Vec3], indices: &[[u32; 3]], rays: &[R
             }
         }
         assert!(rays.is_empty() || indices.is_empty() || stats.nodes > 0, "{context}: counters count");
+        check_packets(&accels, positions, indices, rays, &format!("{context} {preset:?}"));
+    }
+}
+
+/// Packets of 16 (the rays in order, so mixed keys as well as shared ones), every lane live and
+/// then every third lane dead, must answer like brute force lane by lane on every ISA.
+fn check_packets(accels: &[Accel], positions: &[Vec3], indices: &[[u32; 3]], rays: &[Ray], context: &str) {
+    for chunk in rays.chunks(16) {
+        let mut packet = [chunk[0]; 16];
+        packet[..chunk.len()].copy_from_slice(chunk);
+        let expected: Vec<Option<Hit>> = packet.iter().map(|ray| brute_force(positions, indices, ray)).collect();
+        let all = (1u32 << chunk.len()) - 1;
+        for live in [all, all & 0b1011_0110_1101_1011] {
+            for accel in accels {
+                let isa = accel.isa();
+                let hits = accel.intersect_packet(&packet, live);
+                let blocked = accel.occluded_packet(&packet, live);
+                for lane in 0..16 {
+                    if live & (1 << lane) == 0 {
+                        assert_eq!(hits[lane], None, "{context} {isa}: a dead lane has a hit");
+                        continue;
+                    }
+                    let ray = &packet[lane];
+                    assert_eq!(hits[lane], expected[lane], "{context} {isa} packet lane {lane} {ray:?}");
+                    let occluded = blocked & (1 << lane) != 0;
+                    assert_eq!(occluded, expected[lane].is_some(), "{context} {isa} packet occlusion {lane} {ray:?}");
+                }
+            }
+        }
+    }
+}
+
+/// Bundles of 16 nearly parallel rays (a block of camera rays; shadow rays from nearby points to
+/// one target), which share a packet key and so walk the BVH as packets: the same hits as brute
+/// force, through shared edges and vertices, with short and long `tmax`.
+#[test]
+fn coherent_packets_match_brute_force() {
+    let mut rng = TestRng(77);
+    for mesh_index in 0..120 {
+        let kind = mesh_index % 7;
+        let (positions, indices) = random_mesh(&mut rng, kind);
+        if indices.is_empty() {
+            continue;
+        }
+        let scale = if kind == 5 { 1e18 } else { 1.0 };
+        let mut rays = Vec::new();
+        for bundle in 0..8 {
+            let target = positions[indices[rng.below(indices.len())][rng.below(3)] as usize];
+            let origin = rng.vec3(-15.0, 15.0) * scale;
+            let spread = rng.range(0.0, 0.5) * scale;
+            for lane in 0..16 {
+                let ray = if bundle % 2 == 0 {
+                    // Camera-like: one origin, directions fanning around a vertex (lane 0 through it).
+                    let aim = if lane == 0 { target } else { target + rng.vec3(-spread, spread) };
+                    Ray::new(origin, aim - origin)
+                } else {
+                    // Shadow-like: nearby origins, one end point (a vertex: rays through shared edges).
+                    let from = origin + rng.vec3(-spread, spread);
+                    let mut ray = Ray::new(from, target - from);
+                    ray.tmax = if lane % 3 == 0 { 0.999 } else { 1.0 };
+                    ray
+                };
+                rays.push(ray);
+            }
+        }
+        // A NaN direction among coherent rays is traced alone (and hits nothing).
+        rays[5].dir.y = f32::NAN;
+        let accels: Vec<Accel> = Isa::supported()
+            .into_iter()
+            .map(|isa| Accel::build(&positions, &indices, BuildPreset::default(), isa))
+            .collect();
+        check_packets(&accels, &positions, &indices, &rays, &format!("mesh {mesh_index} kind {kind}"));
     }
 }
 

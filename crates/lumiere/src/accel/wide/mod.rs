@@ -10,6 +10,7 @@
 mod collapse;
 mod leaf;
 mod node;
+mod packet;
 mod traverse;
 mod triangles;
 
@@ -19,6 +20,7 @@ use glam::Vec3;
 
 pub(super) use leaf::{LEAF_BIT, blocks as leaf_blocks};
 pub use node::{TriangleBlock, WideNode};
+pub use packet::{PacketKey, RayPacket};
 
 use super::bvh2::{BuildPreset, Bvh};
 

@@ -16,28 +16,29 @@ use crate::math::Ray;
 
 /// The traversal stack, left uninitialised: zeroing it (2.3 KB per ray at `W = 4`) was measured to
 /// cost more than the whole traversal of a small scene. A wide level pushes at most `W - 1`
-/// siblings, so `(W - 1) * MAX_DEPTH + 1` entries would do; stable Rust cannot size an array by an
-/// expression of a const parameter, so the stack holds one row of `W` entries per level.
-struct Stack<const W: usize> {
+/// siblings (`W` in a packet walk, `packet.rs`, which pops the nearest right after), so
+/// `(W - 1) * MAX_DEPTH + 1` entries would do; stable Rust cannot size an array by an expression of
+/// a const parameter, so the stack holds one row of `W` entries per level.
+pub(super) struct Stack<const W: usize> {
     entries: [[MaybeUninit<(u32, f32)>; W]; MAX_DEPTH + 1],
     len: usize,
 }
 
 impl<const W: usize> Stack<W> {
     #[inline(always)]
-    fn new() -> Self {
+    pub(super) fn new() -> Self {
         Stack { entries: [[MaybeUninit::uninit(); W]; MAX_DEPTH + 1], len: 0 }
     }
 
     #[inline(always)]
-    fn push(&mut self, entry: (u32, f32)) {
+    pub(super) fn push(&mut self, entry: (u32, f32)) {
         // The build bounds the depth by MAX_DEPTH and each level pushes at most W - 1 entries.
         self.entries.as_flattened_mut()[self.len] = MaybeUninit::new(entry);
         self.len += 1;
     }
 
     #[inline(always)]
-    fn pop(&mut self) -> Option<(u32, f32)> {
+    pub(super) fn pop(&mut self) -> Option<(u32, f32)> {
         self.len = self.len.checked_sub(1)?;
         // SAFETY: entries below `len` were written by `push` before `len` grew past them.
         Some(unsafe { self.entries.as_flattened()[self.len].assume_init() })

@@ -1,0 +1,402 @@
+//! Packets: `N` coherent rays (a 4x4 block of camera rays, their shadow rays towards one light
+//! point) walk the wide BVH together, ray-major: each child box and each triangle is loaded once
+//! and tested against all `N` rays, in loops over the lanes that the compiler vectorises in the ISA
+//! the caller runs in ([`crate::accel::Accel::simd`]).
+//!
+//! Every lane performs exactly the operations of the single-ray traversal (`traverse.rs`,
+//! `triangles.rs`): the same slab test, the same watertight triangle test with the same scalar
+//! fallbacks, the same "closest, ties to the lower id" rule, so a packet returns the same hits,
+//! bit for bit, as tracing its rays one by one. That needs the rays to share the slab test's entry
+//! planes (direction signs) and the triangle test's axis permutation; [`PacketKey`] says which rays
+//! do, and callers trace the others alone.
+
+use super::WideBvh;
+use super::leaf::{self, LEAF_BIT};
+use super::node::{EMPTY_CHILD, TriangleBlock, WideNode};
+use super::traverse::Stack;
+use crate::accel::Hit;
+use crate::accel::slab::{BOX_EXPANSION, PRUNE_SLACK, safe_reciprocal};
+use crate::geometry::triangle::{CANCELLATION_ERROR, WatertightRay, dominant_axis, intersect_triangle};
+use crate::math::Ray;
+
+/// What rays must share to travel in one packet: the sign of each direction component (which slab
+/// plane is entered first) and the dominant axis (the watertight test's axis permutation follows
+/// from both). Three sign bits and the axis, decided with comparisons only.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PacketKey(u8);
+
+impl PacketKey {
+    /// The key of a ray whose direction has a NaN: such a ray is traced alone.
+    pub const ALONE: PacketKey = PacketKey(u8::MAX);
+
+    #[inline(always)]
+    pub fn of(ray: &Ray) -> PacketKey {
+        let d = ray.dir;
+        if d.is_nan() {
+            return PacketKey::ALONE;
+        }
+        let kz = dominant_axis(d) as u8;
+        let negative = u8::from(d.x < 0.0) | u8::from(d.y < 0.0) << 1 | u8::from(d.z < 0.0) << 2;
+        PacketKey(negative | kz << 3)
+    }
+
+    /// The box row (min x, y, z, then max x, y, z) holding the plane each axis enters first.
+    fn near_rows(self) -> [usize; 3] {
+        [0, 1, 2].map(|axis| if self.0 & (1 << axis) == 0 { axis } else { axis + 3 })
+    }
+
+    /// `WatertightRay`'s `[kx, ky, kz]`: the dominant axis last, x and y swapped if it points down.
+    fn permutation(self) -> [usize; 3] {
+        let kz = usize::from(self.0 >> 3);
+        let (kx, ky) = ((kz + 1) % 3, (kz + 2) % 3);
+        if self.0 & (1 << kz) != 0 { [ky, kx, kz] } else { [kx, ky, kz] }
+    }
+}
+
+/// `N` rays sharing a [`PacketKey`], SoA, splatted for the box and triangle tests.
+pub struct RayPacket<const N: usize> {
+    near_rows: [usize; 3],
+    permutation: [usize; 3],
+    origin: [[f32; N]; 3],
+    dir: [[f32; N]; 3],
+    inv_dir: [[f32; N]; 3],
+    shear: [[f32; N]; 3],
+    tmax: [f32; N],
+}
+
+impl<const N: usize> RayPacket<N> {
+    /// The packet of `rays`, which must all have the key `key` (lanes a caller leaves out repeat
+    /// a ray that does). The reciprocals and shears of `safe_reciprocal` and `WatertightRay`,
+    /// computed in loops over the lanes.
+    #[inline(always)]
+    pub fn new(key: PacketKey, rays: &[Ray; N]) -> Self {
+        let mut packet = RayPacket {
+            near_rows: key.near_rows(),
+            permutation: key.permutation(),
+            origin: [[0.0; N]; 3],
+            dir: [[0.0; N]; 3],
+            inv_dir: [[0.0; N]; 3],
+            shear: [[0.0; N]; 3],
+            tmax: [0.0; N],
+        };
+        for (lane, ray) in rays.iter().enumerate() {
+            debug_assert_eq!(PacketKey::of(ray), key);
+            for axis in 0..3 {
+                packet.origin[axis][lane] = ray.origin[axis];
+                packet.dir[axis][lane] = ray.dir[axis];
+            }
+            packet.tmax[lane] = ray.tmax;
+        }
+        for axis in 0..3 {
+            for lane in 0..N {
+                packet.inv_dir[axis][lane] = safe_reciprocal(packet.dir[axis][lane]);
+            }
+        }
+        let [kx, ky, kz] = packet.permutation;
+        for lane in 0..N {
+            let d = [packet.dir[kx][lane], packet.dir[ky][lane], packet.dir[kz][lane]];
+            packet.shear[0][lane] = d[0] / d[2];
+            packet.shear[1][lane] = d[1] / d[2];
+            packet.shear[2][lane] = 1.0 / d[2];
+        }
+        packet
+    }
+
+    /// Lane `lane`'s ray, for the scalar test's f64 fallbacks.
+    fn watertight(&self, lane: usize) -> WatertightRay {
+        let vector = |v: &[[f32; N]; 3]| glam::Vec3::new(v[0][lane], v[1][lane], v[2][lane]);
+        WatertightRay::new(&Ray { origin: vector(&self.origin), dir: vector(&self.dir), tmax: self.tmax[lane] })
+    }
+
+    /// Per lane, whether the ray enters child `child` of `node` before `limit` (the single-ray slab
+    /// test of `traverse.rs`, one lane per ray), as a mask, and the nearest entry among them.
+    #[inline(always)]
+    fn enter<const W: usize>(&self, node: &WideNode<W>, child: usize, limit: &[f32; N]) -> (u32, f32) {
+        let mut near = [0.0f32; N];
+        let mut far = *limit;
+        for axis in 0..3 {
+            let near_plane = node.bounds[self.near_rows[axis]][child];
+            let far_plane = node.bounds[(self.near_rows[axis] + 3) % 6][child];
+            let (origin, inv_dir) = (&self.origin[axis], &self.inv_dir[axis]);
+            for lane in 0..N {
+                near[lane] = max_ps(near[lane], (near_plane - origin[lane]) * inv_dir[lane]);
+                far[lane] = min_ps(far[lane], (far_plane - origin[lane]) * inv_dir[lane] * BOX_EXPANSION);
+            }
+        }
+        let mut mask = 0u32;
+        let mut nearest = f32::INFINITY;
+        for lane in 0..N {
+            let enters = near[lane] <= far[lane];
+            mask |= u32::from(enters) << lane;
+            nearest = if enters && near[lane] < nearest { near[lane] } else { nearest };
+        }
+        (mask, nearest)
+    }
+}
+
+/// `_mm_max_ps(a, b)` on one lane: `b` when either is NaN, as the single-ray kernels compute it.
+#[inline(always)]
+fn max_ps(a: f32, b: f32) -> f32 {
+    if a > b { a } else { b }
+}
+
+/// `_mm_min_ps(a, b)` on one lane.
+#[inline(always)]
+fn min_ps(a: f32, b: f32) -> f32 {
+    if a < b { a } else { b }
+}
+
+/// The closest hits found so far, one per lane (`t` infinite and id `u32::MAX` for none).
+struct Closest<const N: usize> {
+    t: [f32; N],
+    triangle: [u32; N],
+    u: [f32; N],
+    v: [f32; N],
+}
+
+impl<const N: usize> Closest<N> {
+    /// Keeps the hit of lane `lane` if it is closer, or as close with a lower id (the single-ray rule).
+    #[inline(always)]
+    fn offer(&mut self, lane: usize, t: f32, triangle: u32, u: f32, v: f32) {
+        if t < self.t[lane] || (t == self.t[lane] && triangle < self.triangle[lane]) {
+            (self.t[lane], self.triangle[lane], self.u[lane], self.v[lane]) = (t, triangle, u, v);
+        }
+    }
+}
+
+/// Pushes the children of `node` that some lane of `packet` enters before its `limit` onto the
+/// walk's stack (each with the nearest entry of any lane into it), nearest last, so that it is
+/// popped first.
+#[inline(always)]
+fn push_children<const N: usize, const W: usize>(
+    stack: &mut Stack<W>,
+    packet: &RayPacket<N>,
+    node: &WideNode<W>,
+    limit: &[f32; N],
+) {
+    let mut entered = [(0u32, 0f32); W];
+    let mut count = 0;
+    for child in 0..W {
+        if node.children[child] == EMPTY_CHILD {
+            continue;
+        }
+        let (mask, nearest) = packet.enter(node, child, limit);
+        if mask == 0 {
+            continue;
+        }
+        // Insertion sort, farthest first.
+        let mut i = count;
+        while i > 0 && entered[i - 1].1 < nearest {
+            entered[i] = entered[i - 1];
+            i -= 1;
+        }
+        entered[i] = (node.children[child], nearest);
+        count += 1;
+    }
+    for &entry in &entered[..count] {
+        stack.push(entry);
+    }
+}
+
+/// Per lane, the watertight test of triangle `lane_in_block` of `block`: the operations of
+/// `intersect_block` (hence of the scalar `intersect_triangle`), one ray per lane; keep the three
+/// in step (the tests compare them bit for bit). Returns the
+/// lanes hit (with `t`, `u`, `v` filled in) and those the scalar test must decide (f64 fallbacks).
+#[inline(always)]
+fn test_triangle<const N: usize, const W: usize>(
+    packet: &RayPacket<N>,
+    block: &TriangleBlock<W>,
+    lane_in_block: usize,
+    tmax: &[f32; N],
+    out: &mut [[f32; N]; 3],
+) -> (u32, u32) {
+    let [kx, ky, kz] = packet.permutation;
+    let vertex = |corner: usize, axis: usize| block.vertices[corner][axis][lane_in_block];
+    let (mut hit, mut needs_scalar) = (0u32, 0u32);
+    for lane in 0..N {
+        let rel = |corner: usize, axis: usize| vertex(corner, axis) - packet.origin[axis][lane];
+        let [sx, sy, sz] = [packet.shear[0][lane], packet.shear[1][lane], packet.shear[2][lane]];
+        let (a_kz, b_kz, c_kz) = (rel(0, kz), rel(1, kz), rel(2, kz));
+        let ax = rel(0, kx) - sx * a_kz;
+        let ay = rel(0, ky) - sy * a_kz;
+        let bx = rel(1, kx) - sx * b_kz;
+        let by = rel(1, ky) - sy * b_kz;
+        let cx = rel(2, kx) - sx * c_kz;
+        let cy = rel(2, ky) - sy * c_kz;
+        let (u1, u2, v1, v2, w1, w2) = (cx * by, cy * bx, ax * cy, ay * cx, bx * ay, by * ax);
+        let u = u1 - u2;
+        let v = v1 - v2;
+        let w = w1 - w2;
+        let negative = (u < 0.0) | (v < 0.0) | (w < 0.0);
+        let positive = (u > 0.0) | (v > 0.0) | (w > 0.0);
+        let inside = !(negative & positive);
+        let zero_edge = (u == 0.0) | (v == 0.0) | (w == 0.0);
+        let det = u + v + w;
+        let (az, bz, cz) = (sz * a_kz, sz * b_kz, sz * c_kz);
+        let t_scaled = u * az + v * bz + w * cz;
+        let overflow = !(det.is_finite() & t_scaled.is_finite());
+        let error =
+            (u1.abs() + u2.abs()) * az.abs() + (v1.abs() + v2.abs()) * bz.abs() + (w1.abs() + w2.abs()) * cz.abs();
+        let cancel = error * CANCELLATION_ERROR > t_scaled.abs();
+        let scalar = zero_edge | (inside & (overflow | cancel));
+        let inv_det = 1.0 / det;
+        let t = t_scaled * inv_det;
+        let accepted = (det != 0.0) & (t_scaled * det > 0.0) & (t <= tmax[lane]);
+        hit |= u32::from(inside & accepted & !scalar) << lane;
+        needs_scalar |= u32::from(scalar) << lane;
+        out[0][lane] = t;
+        out[1][lane] = v * inv_det;
+        out[2][lane] = w * inv_det;
+    }
+    (hit, needs_scalar)
+}
+
+/// The scalar test, with its f64 fallbacks, for the lanes `test_triangle` could not decide.
+#[cold]
+#[inline(never)]
+fn test_triangle_scalar<const N: usize, const W: usize>(
+    packet: &RayPacket<N>,
+    block: &TriangleBlock<W>,
+    lane_in_block: usize,
+    tmax: &[f32; N],
+    lanes: u32,
+) -> [Option<crate::geometry::triangle::TriangleHit>; N] {
+    let corner = |c: usize| glam::Vec3::from_array([0, 1, 2].map(|a| block.vertices[c][a][lane_in_block]));
+    let mut hits = [None; N];
+    for (lane, hit) in hits.iter_mut().enumerate().filter(|(lane, _)| lanes & (1 << lane) != 0) {
+        *hit = intersect_triangle(&packet.watertight(lane), tmax[lane], corner(0), corner(1), corner(2));
+    }
+    hits
+}
+
+/// Whether triangle `lane` of a block is real, not the repeat of its predecessor that pads a leaf.
+#[inline(always)]
+fn is_padding<const W: usize>(block: &TriangleBlock<W>, lane: usize) -> bool {
+    lane > 0 && block.ids[lane] == block.ids[lane - 1]
+}
+
+// Inlined into the caller, which runs them in its ISA's `Accel::simd`: unlike the single-ray entry
+// points, these own no dispatch of their own.
+impl<const W: usize, L> WideBvh<W, L> {
+    /// The closest hit of every lane of `packet` (as [`WideBvh::intersect`] would return it).
+    #[inline(always)]
+    pub fn intersect_packet<const N: usize>(&self, packet: &RayPacket<N>) -> [Option<Hit>; N] {
+        let mut closest = Closest { t: [f32::INFINITY; N], triangle: [u32::MAX; N], u: [0.0; N], v: [0.0; N] };
+        // Each lane's distance limit: its ray's tmax, then its closest hit.
+        let mut tmax = packet.tmax;
+        let mut stack = Stack::<W>::new();
+        stack.push((0, 0.0));
+        let mut farthest_limit = tmax.iter().fold(f32::NEG_INFINITY, |a, &b| max_ps(a, b));
+        let mut out = [[0.0f32; N]; 3];
+        while let Some((reference, nearest)) = stack.pop() {
+            // No lane can find anything closer in there (the single-ray pruning, for the packet).
+            if nearest > farthest_limit * PRUNE_SLACK {
+                continue;
+            }
+            if reference & LEAF_BIT == 0 {
+                let limit = tmax.map(|t| t * PRUNE_SLACK);
+                push_children(&mut stack, packet, &self.nodes[reference as usize], &limit);
+                continue;
+            }
+            for block in &self.blocks[leaf::blocks::<W>(reference)] {
+                for lane_in_block in (0..W).filter(|&l| !is_padding(block, l)) {
+                    let id = block.ids[lane_in_block];
+                    let (mut hit, scalar) = test_triangle(packet, block, lane_in_block, &tmax, &mut out);
+                    if scalar != 0 {
+                        let resolved = test_triangle_scalar(packet, block, lane_in_block, &tmax, scalar);
+                        for (lane, h) in resolved.iter().enumerate() {
+                            if let Some(h) = h {
+                                hit |= 1 << lane;
+                                (out[0][lane], out[1][lane], out[2][lane]) = (h.t, h.u, h.v);
+                            }
+                        }
+                    }
+                    if hit == 0 {
+                        continue;
+                    }
+                    for lane in 0..N {
+                        if hit & (1 << lane) != 0 {
+                            closest.offer(lane, out[0][lane], id, out[1][lane], out[2][lane]);
+                            tmax[lane] = closest.t[lane];
+                        }
+                    }
+                    farthest_limit = tmax.iter().fold(f32::NEG_INFINITY, |a, &b| max_ps(a, b));
+                }
+            }
+        }
+        std::array::from_fn(|lane| {
+            (closest.triangle[lane] != u32::MAX).then(|| Hit {
+                t: closest.t[lane],
+                triangle: closest.triangle[lane],
+                u: closest.u[lane],
+                v: closest.v[lane],
+            })
+        })
+    }
+
+    /// Which lanes of `packet` are blocked, bit `i` for lane `i` (as [`WideBvh::occluded`] would
+    /// answer each); stops as soon as every lane of `wanted` is.
+    #[inline(always)]
+    pub fn occluded_packet<const N: usize>(&self, packet: &RayPacket<N>, wanted: u32) -> u32 {
+        let limit = packet.tmax.map(|t| t * PRUNE_SLACK);
+        let mut blocked = 0u32;
+        let mut stack = Stack::<W>::new();
+        stack.push((0, 0.0));
+        let mut out = [[0.0f32; N]; 3];
+        while let Some((reference, _)) = stack.pop() {
+            if reference & LEAF_BIT == 0 {
+                push_children(&mut stack, packet, &self.nodes[reference as usize], &limit);
+                continue;
+            }
+            for block in &self.blocks[leaf::blocks::<W>(reference)] {
+                for lane_in_block in (0..W).filter(|&l| !is_padding(block, l)) {
+                    let (hit, scalar) = test_triangle(packet, block, lane_in_block, &packet.tmax, &mut out);
+                    blocked |= hit;
+                    let undecided = scalar & !blocked;
+                    if undecided != 0 {
+                        let resolved = test_triangle_scalar(packet, block, lane_in_block, &packet.tmax, undecided);
+                        for (lane, h) in resolved.iter().enumerate() {
+                            blocked |= u32::from(h.is_some()) << lane;
+                        }
+                    }
+                    if blocked & wanted == wanted {
+                        return blocked;
+                    }
+                }
+            }
+        }
+        blocked
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+
+    /// The key's permutation and the packet's shears are `WatertightRay`'s, for directions along
+    /// and between the axes, of either sign, zero components included.
+    #[test]
+    fn packets_shear_rays_as_the_watertight_test_does() {
+        let values = [-2.0f32, -1.0, -0.5, -0.0, 0.0, 0.5, 1.0, 2.0];
+        let mut rays = Vec::new();
+        for &x in &values {
+            for &y in &values {
+                for &z in &values {
+                    if x != 0.0 || y != 0.0 || z != 0.0 {
+                        rays.push(Ray::new(Vec3::new(0.25, -1.0, 3.0), Vec3::new(x, y, z)));
+                    }
+                }
+            }
+        }
+        for ray in rays {
+            let key = PacketKey::of(&ray);
+            let (permutation, shear) = WatertightRay::new(&ray).permutation_and_shear();
+            assert_eq!(key.permutation(), permutation, "{ray:?}");
+            let packet = RayPacket::<4>::new(key, &[ray; 4]);
+            let packet_shear = [0, 1, 2].map(|axis| packet.shear[axis][3]);
+            assert_eq!(packet_shear.map(f32::to_bits), shear.map(f32::to_bits), "{ray:?}");
+        }
+    }
+}
