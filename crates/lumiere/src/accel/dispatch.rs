@@ -61,10 +61,11 @@ impl Accel {
     /// If this CPU cannot run `isa` ([`Isa::is_supported`]): callers check user input first.
     pub fn build(positions: &[Vec3], indices: &[[u32; 3]], preset: BuildPreset, isa: Isa) -> Accel {
         let binary = match isa.width() {
-            4 => Bvh::build_for_width::<4>(positions, indices, preset),
-            _ => Bvh::build_for_width::<8>(positions, indices, preset),
+            4 => Bvh::build_tree_for_width::<4>(positions, indices, preset),
+            _ => Bvh::build_tree_for_width::<8>(positions, indices, preset),
         };
-        Accel::from_binary(&binary, isa)
+        let corners = |slot: usize| indices[binary.triangle_id(slot) as usize].map(|i| positions[i as usize]);
+        Accel::collapse(&binary, isa, corners)
     }
 
     /// Collapses a binary BVH (any; one built for `isa.width()` packs best) to `isa`'s layout.
@@ -72,14 +73,19 @@ impl Accel {
     /// # Panics
     /// If this CPU cannot run `isa`.
     pub fn from_binary(binary: &Bvh, isa: Isa) -> Accel {
+        Accel::collapse(binary, isa, |slot| binary.vertices[slot])
+    }
+
+    /// Collapses the tree of `binary`, with the corners of leaf-order slot `i` at `corners(i)`.
+    fn collapse(binary: &Bvh, isa: Isa, corners: impl Fn(usize) -> [Vec3; 3]) -> Accel {
         assert!(isa.is_supported(), "this CPU cannot run the {isa} kernels");
         let bvh = match isa {
-            Isa::Portable => IsaBvh::Portable(WideBvh::from_binary(binary)),
+            Isa::Portable => IsaBvh::Portable(WideBvh::from_tree(binary, corners)),
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx2 => IsaBvh::Avx2(WideBvh::from_binary(binary)),
+            Isa::Avx2 => IsaBvh::Avx2(WideBvh::from_tree(binary, corners)),
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx512 => IsaBvh::Avx512(WideBvh::from_binary(binary)),
-            _ => IsaBvh::Sse2(WideBvh::from_binary(binary)),
+            Isa::Avx512 => IsaBvh::Avx512(WideBvh::from_tree(binary, corners)),
+            _ => IsaBvh::Sse2(WideBvh::from_tree(binary, corners)),
         };
         Accel { bvh, isa }
     }

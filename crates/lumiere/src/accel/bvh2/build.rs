@@ -4,6 +4,11 @@
 //! surface-area cost, and becomes a leaf when no split beats intersecting its triangles directly.
 //! Large subtrees are built in parallel with rayon and stitched into one array, so siblings stay
 //! adjacent and the layout is the same whatever the thread count.
+//!
+//! Triangles travel as 32-byte references holding their box and id (Embree's `PrimRef`), which the
+//! partition moves: every pass reads memory in order, where an array of ids into a box array cost a
+//! cache miss per triangle in the top levels. The partition also gathers both sides' bounds, so a
+//! node never makes a pass of its own to find them.
 
 use glam::{Vec3, Vec3A};
 use rayon::prelude::*;
@@ -94,6 +99,27 @@ impl Box3A {
     fn to_aabb(self) -> Aabb {
         Aabb { min: self.min.into(), max: self.max.into() }
     }
+
+    #[inline(always)]
+    fn centroid(self) -> Vec3A {
+        0.5 * (self.min + self.max)
+    }
+}
+
+/// A triangle as the build moves it: its box and its id, 32 bytes.
+#[derive(Clone, Copy)]
+#[repr(C, align(16))]
+struct PrimRef {
+    min: [f32; 3],
+    id: u32,
+    max: [f32; 3],
+}
+
+impl PrimRef {
+    #[inline(always)]
+    fn bounds(&self) -> Box3A {
+        Box3A { min: Vec3A::from_array(self.min), max: Vec3A::from_array(self.max) }
+    }
 }
 
 /// Bounds of the triangles of a node and of their centroids, gathered in one pass.
@@ -109,96 +135,116 @@ impl NodeBounds {
     fn merge(self, o: NodeBounds) -> NodeBounds {
         NodeBounds { bounds: self.bounds.union(o.bounds), centroids: self.centroids.union(o.centroids) }
     }
-}
 
-/// What every node of one build shares. `W` is the block width the SAH counts leaves in: a const,
-/// not a field, so that `leaf_cost` divides by a constant in the split sweep.
-struct Context<'a, const W: usize> {
-    bounds: &'a [Box3A],
-    centroids: &'a [Vec3A],
-    bins: usize,
-}
+    #[inline(always)]
+    fn grow(self, b: Box3A) -> NodeBounds {
+        NodeBounds { bounds: self.bounds.union(b), centroids: self.centroids.grow(b.centroid()) }
+    }
 
-impl<const W: usize> Context<'_, W> {
-    fn node_bounds(&self, order: &[u32]) -> NodeBounds {
-        let gather = |ids: &[u32]| {
-            ids.iter().fold(NodeBounds::EMPTY, |acc, &i| NodeBounds {
-                bounds: acc.bounds.union(self.bounds[i as usize]),
-                centroids: acc.centroids.grow(self.centroids[i as usize]),
-            })
-        };
-        if order.len() > PARALLEL_BINNING_THRESHOLD {
-            order.par_chunks(BINNING_CHUNK).map(gather).reduce(|| NodeBounds::EMPTY, NodeBounds::merge)
+    /// The bounds of `refs`, in parallel chunks when there are many.
+    fn of(refs: &[PrimRef]) -> NodeBounds {
+        let gather = |refs: &[PrimRef]| refs.iter().fold(NodeBounds::EMPTY, |acc, r| acc.grow(r.bounds()));
+        if refs.len() > PARALLEL_BINNING_THRESHOLD {
+            refs.par_chunks(BINNING_CHUNK).map(gather).reduce(|| NodeBounds::EMPTY, NodeBounds::merge)
         } else {
-            gather(order)
+            gather(refs)
         }
     }
 }
 
-pub fn build<const W: usize>(positions: &[Vec3], indices: &[[u32; 3]], preset: BuildPreset) -> Bvh {
-    let corners = |t: &[u32; 3]| t.map(|i| positions[i as usize]);
-    let bounds: Vec<Box3A> = indices
-        .par_iter()
-        .map(|t| {
-            let [a, b, c] = corners(t).map(Vec3A::from);
-            Box3A { min: a.min(b).min(c), max: a.max(b).max(c) }
-        })
-        .collect();
-    let centroids: Vec<Vec3A> = bounds.par_iter().map(|b| 0.5 * (b.min + b.max)).collect();
-    // Zero-area triangles have no surface and are never hit (see `is_degenerate`).
-    let mut order: Vec<u32> = (0..indices.len() as u32)
-        .filter(|&i| {
-            let [p0, p1, p2] = corners(&indices[i as usize]);
-            !is_degenerate(p0, p1, p2)
-        })
-        .collect();
-    let ctx = Context::<W> { bounds: &bounds, centroids: &centroids, bins: preset.bins() };
-
-    let nodes =
-        if order.is_empty() { vec![Node::new(Aabb::EMPTY, 0, 0)] } else { build_subtree(&ctx, &mut order, 0, 0) };
-    let vertices = order.iter().map(|&id| corners(&indices[id as usize])).collect();
-    Bvh { nodes, vertices, triangle_ids: order, input_triangles: indices.len(), block_width: W }
+/// What every node of one build shares. `W` is the block width the SAH counts leaves in: a const,
+/// not a field, so that `leaf_cost` divides by a constant in the split sweep.
+struct Context<const W: usize> {
+    bins: usize,
 }
 
-/// Builds the subtree over `order` (whose first element is triangle slot `offset` in leaf order)
-/// into a node array whose root is at index 0.
-fn build_subtree<const W: usize>(ctx: &Context<W>, order: &mut [u32], offset: usize, depth: usize) -> Vec<Node> {
-    let mut nodes = Vec::with_capacity(order.len());
+/// Builds the tree; with `copy_vertices` false the leaf-order corner copy is left out (for a tree
+/// that is collapsed right away, see [`Bvh::build_tree_for_width`]).
+pub fn build<const W: usize>(
+    positions: &[Vec3],
+    indices: &[[u32; 3]],
+    preset: BuildPreset,
+    copy_vertices: bool,
+) -> Bvh {
+    let corners = |t: &[u32; 3]| t.map(|i| positions[i as usize]);
+    // Zero-area triangles have no surface and are never hit (see `is_degenerate`).
+    let mut refs: Vec<PrimRef> = indices
+        .par_iter()
+        .enumerate()
+        .filter_map(|(id, t)| {
+            let [p0, p1, p2] = corners(t);
+            if is_degenerate(p0, p1, p2) {
+                return None;
+            }
+            let [a, b, c] = [p0, p1, p2].map(Vec3A::from);
+            let (min, max) = (a.min(b).min(c), a.max(b).max(c));
+            Some(PrimRef { min: min.to_array(), id: id as u32, max: max.to_array() })
+        })
+        .collect();
+    let ctx = Context::<W> { bins: preset.bins() };
+
+    let nodes = if refs.is_empty() {
+        vec![Node::new(Aabb::EMPTY, 0, 0)]
+    } else {
+        let bounds = NodeBounds::of(&refs);
+        build_subtree(&ctx, &mut refs, bounds, 0, 0)
+    };
+    let triangle_ids: Vec<u32> = refs.par_iter().map(|r| r.id).collect();
+    let vertices = if copy_vertices {
+        triangle_ids.par_iter().map(|&id| corners(&indices[id as usize])).collect()
+    } else {
+        Vec::new()
+    };
+    Bvh { nodes, vertices, triangle_ids, input_triangles: indices.len(), block_width: W }
+}
+
+/// Builds the subtree over `refs` (whose bounds are `bounds`, and whose first element is triangle
+/// slot `offset` in leaf order) into a node array whose root is at index 0.
+fn build_subtree<const W: usize>(
+    ctx: &Context<W>,
+    refs: &mut [PrimRef],
+    bounds: NodeBounds,
+    offset: usize,
+    depth: usize,
+) -> Vec<Node> {
+    let mut nodes = Vec::with_capacity(refs.len());
     nodes.push(Node::default());
-    build_into(ctx, order, offset, depth, 0, &mut nodes);
+    build_into(ctx, refs, bounds, offset, depth, 0, &mut nodes);
     nodes
 }
 
-/// Fills node `index` of `nodes` for the triangles `order`, appending its descendants.
+/// Fills node `index` of `nodes` for the triangles `refs`, appending its descendants.
 fn build_into<const W: usize>(
     ctx: &Context<W>,
-    order: &mut [u32],
+    refs: &mut [PrimRef],
+    node_bounds: NodeBounds,
     offset: usize,
     depth: usize,
     index: usize,
     nodes: &mut Vec<Node>,
 ) {
-    let node_bounds = ctx.node_bounds(order);
     let bounds = node_bounds.bounds.to_aabb();
-    let Some(mid) = choose_split(ctx, order, &bounds, &node_bounds.centroids.to_aabb(), depth) else {
-        nodes[index] = Node::new(bounds, offset as u32, order.len() as u32);
+    let Some((mid, left_bounds, right_bounds)) =
+        choose_split(ctx, refs, &bounds, &node_bounds.centroids.to_aabb(), depth)
+    else {
+        nodes[index] = Node::new(bounds, offset as u32, refs.len() as u32);
         return;
     };
-    let (left, right) = order.split_at_mut(mid);
+    let (left, right) = refs.split_at_mut(mid);
     let first_child = nodes.len();
     nodes[index] = Node::new(bounds, first_child as u32, 0);
 
     if left.len() + right.len() >= PARALLEL_THRESHOLD {
         let (left_nodes, right_nodes) = rayon::join(
-            || build_subtree(ctx, left, offset, depth + 1),
-            || build_subtree(ctx, right, offset + mid, depth + 1),
+            || build_subtree(ctx, left, left_bounds, offset, depth + 1),
+            || build_subtree(ctx, right, right_bounds, offset + mid, depth + 1),
         );
         stitch(nodes, first_child, left_nodes, right_nodes);
     } else {
         nodes.push(Node::default());
         nodes.push(Node::default());
-        build_into(ctx, left, offset, depth + 1, first_child, nodes);
-        build_into(ctx, right, offset + mid, depth + 1, first_child + 1, nodes);
+        build_into(ctx, left, left_bounds, offset, depth + 1, first_child, nodes);
+        build_into(ctx, right, right_bounds, offset + mid, depth + 1, first_child + 1, nodes);
     }
 }
 
@@ -223,15 +269,16 @@ fn stitch(nodes: &mut Vec<Node>, first_child: usize, left: Vec<Node>, right: Vec
     nodes.extend(right[1..].iter().map(|&n| relink(n, first_child + 1, right_rest)));
 }
 
-/// Decides whether to split `order`; if so, partitions it in place and returns the size of the left part.
+/// Decides whether to split `refs`; if so, partitions it in place and returns the size of the left
+/// part and the bounds of both parts.
 fn choose_split<const W: usize>(
     ctx: &Context<W>,
-    order: &mut [u32],
+    refs: &mut [PrimRef],
     bounds: &Aabb,
     centroid_bounds: &Aabb,
     depth: usize,
-) -> Option<usize> {
-    let count = order.len();
+) -> Option<(usize, NodeBounds, NodeBounds)> {
+    let count = refs.len();
     if count <= 1 {
         return None;
     }
@@ -240,11 +287,11 @@ fn choose_split<const W: usize>(
     if depth >= SAH_DEPTH_LIMIT || !binnable {
         // Degenerate input (all centroids equal, or overflowing extents) or too deep for the SAH to be
         // trusted: a leaf if small enough, else an object-median halving, which always terminates.
-        return median_split(ctx, order, if binnable { extent.max_position() } else { 0 });
+        return median_split(refs, if binnable { extent.max_position() } else { 0 });
     }
 
-    let Some(split) = best_binned_split(ctx, order, centroid_bounds) else {
-        return median_split(ctx, order, extent.max_position());
+    let Some(split) = best_binned_split(ctx, refs, centroid_bounds) else {
+        return median_split(refs, extent.max_position());
     };
     let as_leaf = INTERSECTION_COST * leaf_cost(count, W);
     let split_cost = TRAVERSAL_COST + INTERSECTION_COST * split.cost / bounds.half_area();
@@ -253,19 +300,19 @@ fn choose_split<const W: usize>(
     }
     let (axis, min, scale) = (split.axis, centroid_bounds.min[split.axis], split.scale);
     let bins = ctx.bins;
-    let mid = partition(order, |&i| bin_index(ctx.centroids[i as usize][axis], min, scale, bins) < split.bin);
-    Some(mid)
+    Some(partition(refs, |b| bin_index(b.centroid()[axis], min, scale, bins) < split.bin))
 }
 
-/// Halves `order` by centroid along `axis`, or makes a leaf if it is small enough.
-fn median_split<const W: usize>(ctx: &Context<W>, order: &mut [u32], axis: usize) -> Option<usize> {
-    if order.len() <= MAX_LEAF_SIZE {
+/// Halves `refs` by centroid along `axis`, or makes a leaf if it is small enough.
+fn median_split(refs: &mut [PrimRef], axis: usize) -> Option<(usize, NodeBounds, NodeBounds)> {
+    if refs.len() <= MAX_LEAF_SIZE {
         return None;
     }
-    let mid = order.len() / 2;
-    let key = |i: &u32| ctx.centroids[*i as usize][axis];
-    order.select_nth_unstable_by(mid, |a, b| key(a).total_cmp(&key(b)));
-    Some(mid)
+    let mid = refs.len() / 2;
+    let key = |r: &PrimRef| r.bounds().centroid()[axis];
+    refs.select_nth_unstable_by(mid, |a, b| key(a).total_cmp(&key(b)));
+    let (left, right) = refs.split_at(mid);
+    Some((mid, NodeBounds::of(left), NodeBounds::of(right)))
 }
 
 struct Split {
@@ -295,19 +342,14 @@ impl Bin {
 /// the bins it uses (a 64-bin grid is 9 KB, and there is one per node).
 type BinGrid<const B: usize> = [[Bin; B]; 3];
 
-/// Bins the centroids of `order` along the three axes at once.
-fn bin_triangles<const W: usize, const B: usize>(
-    ctx: &Context<W>,
-    order: &[u32],
-    min: Vec3A,
-    scale: Vec3A,
-) -> BinGrid<B> {
+/// Bins the centroids of `refs` along the three axes at once.
+fn bin_triangles<const B: usize>(refs: &[PrimRef], min: Vec3A, scale: Vec3A) -> BinGrid<B> {
     let last = Vec3A::splat((B - 1) as f32);
     let mut grid = [[Bin::EMPTY; B]; 3];
-    for &i in order {
-        let b = ctx.bounds[i as usize];
+    for r in refs {
+        let b = r.bounds();
         // Float min before the integer conversion keeps the index in range (NaN never occurs here).
-        let index = ((ctx.centroids[i as usize] - min) * scale).min(last).to_array();
+        let index = ((b.centroid() - min) * scale).min(last).to_array();
         for axis in 0..3 {
             let bin = &mut grid[axis][index[axis] as usize];
             bin.bounds = bin.bounds.union(b);
@@ -328,30 +370,25 @@ fn merge_grids<const B: usize>(mut a: BinGrid<B>, b: BinGrid<B>) -> BinGrid<B> {
 
 /// The cheapest bin boundary over the three axes, or None if every candidate puts all triangles
 /// on one side (possible only for degenerate centroid layouts).
-fn best_binned_split<const W: usize>(ctx: &Context<W>, order: &[u32], centroid_bounds: &Aabb) -> Option<Split> {
+fn best_binned_split<const W: usize>(ctx: &Context<W>, refs: &[PrimRef], centroid_bounds: &Aabb) -> Option<Split> {
     match ctx.bins {
-        8 => best_binned_split_with::<W, 8>(ctx, order, centroid_bounds),
-        16 => best_binned_split_with::<W, 16>(ctx, order, centroid_bounds),
-        _ => best_binned_split_with::<W, 64>(ctx, order, centroid_bounds),
+        8 => best_binned_split_with::<W, 8>(refs, centroid_bounds),
+        16 => best_binned_split_with::<W, 16>(refs, centroid_bounds),
+        _ => best_binned_split_with::<W, 64>(refs, centroid_bounds),
     }
 }
 
-fn best_binned_split_with<const W: usize, const B: usize>(
-    ctx: &Context<W>,
-    order: &[u32],
-    centroid_bounds: &Aabb,
-) -> Option<Split> {
+fn best_binned_split_with<const W: usize, const B: usize>(refs: &[PrimRef], centroid_bounds: &Aabb) -> Option<Split> {
     let bins = B;
     let extent = centroid_bounds.extent();
     let scale = Vec3::select(extent.cmpgt(Vec3::ZERO), bins as f32 / extent, Vec3::ZERO);
     let (min, scale_a) = (Vec3A::from(centroid_bounds.min), Vec3A::from(scale));
-    let grid = if order.len() > PARALLEL_BINNING_THRESHOLD {
-        order
-            .par_chunks(BINNING_CHUNK)
-            .map(|chunk| bin_triangles::<W, B>(ctx, chunk, min, scale_a))
+    let grid = if refs.len() > PARALLEL_BINNING_THRESHOLD {
+        refs.par_chunks(BINNING_CHUNK)
+            .map(|chunk| bin_triangles::<B>(chunk, min, scale_a))
             .reduce(|| [[Bin::EMPTY; B]; 3], merge_grids)
     } else {
-        bin_triangles::<W, B>(ctx, order, min, scale_a)
+        bin_triangles::<B>(refs, min, scale_a)
     };
 
     let mut best: Option<Split> = None;
@@ -370,7 +407,7 @@ fn best_binned_split_with<const W: usize, const B: usize>(
         let mut left = Bin::EMPTY;
         for k in 1..bins {
             left = left.merge(row[k - 1]);
-            if left.count == 0 || left.count as usize == order.len() {
+            if left.count == 0 || left.count as usize == refs.len() {
                 continue;
             }
             let cost = left.bounds.to_aabb().half_area() * leaf_cost(left.count as usize, W) + right_cost[k];
@@ -387,14 +424,21 @@ fn bin_index(c: f32, min: f32, scale: f32, bins: usize) -> usize {
     (((c - min) * scale) as usize).min(bins - 1)
 }
 
-/// Stable-enough in-place partition: elements satisfying `pred` first; returns their count.
-fn partition(order: &mut [u32], pred: impl Fn(&u32) -> bool) -> usize {
-    let mut first_false = 0;
-    for i in 0..order.len() {
-        if pred(&order[i]) {
-            order.swap(i, first_false);
-            first_false += 1;
+/// In-place partition, elements whose box `goes_left` first (Lomuto's swaps: the order, hence the
+/// tree, is this build's own), gathering both sides' bounds on the way. Returns the left count and
+/// the bounds of the left and right parts.
+fn partition(refs: &mut [PrimRef], goes_left: impl Fn(Box3A) -> bool) -> (usize, NodeBounds, NodeBounds) {
+    let (mut left, mut right) = (NodeBounds::EMPTY, NodeBounds::EMPTY);
+    let mut first_right = 0;
+    for i in 0..refs.len() {
+        let b = refs[i].bounds();
+        if goes_left(b) {
+            left = left.grow(b);
+            refs.swap(i, first_right);
+            first_right += 1;
+        } else {
+            right = right.grow(b);
         }
     }
-    first_false
+    (first_right, left, right)
 }

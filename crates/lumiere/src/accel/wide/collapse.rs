@@ -3,6 +3,8 @@
 
 use std::marker::PhantomData;
 
+use glam::Vec3;
+
 use super::node::{TriangleBlock, WideNode};
 use super::{WideBvh, leaf};
 use crate::accel::bvh2::{Bvh, Node};
@@ -12,6 +14,12 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
     /// Collapses a binary BVH. Any binary tree will do; one built for blocks of `W` triangles
     /// (`Bvh::build_for_width::<W>`) has the leaves this layout packs best.
     pub fn from_binary(bvh: &Bvh) -> Self {
+        Self::from_tree(bvh, |slot| bvh.vertices[slot])
+    }
+
+    /// Collapses the tree of `bvh`, reading the corners of the triangle in leaf-order slot `i`
+    /// from `corners(i)` (so that the tree need not hold a copy of them).
+    pub(in crate::accel) fn from_tree(bvh: &Bvh, corners: impl Fn(usize) -> [Vec3; 3]) -> Self {
         // The byte budgets of this width, checked at compile time.
         let () = WideNode::<W>::BYTE_BUDGET;
         let () = TriangleBlock::<W>::BYTE_BUDGET;
@@ -19,9 +27,12 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
         // kernel this CPU cannot run.
         assert!(L::supported(), "this CPU cannot run the kernel of a {W}-wide BVH");
 
+        // Every leaf's blocks, counted up front: growing the block array by doubling copied it
+        // and touched fresh memory over and over (a sixth of the bunny-1m build).
+        let block_count = bvh.nodes().iter().filter(|n| n.is_leaf()).map(|n| (n.count as usize).div_ceil(W)).sum();
         let mut wide = WideBvh {
             nodes: Vec::new(),
-            blocks: Vec::new(),
+            blocks: Vec::with_capacity(block_count),
             triangle_count: bvh.triangle_count(),
             kernel: PhantomData,
         };
@@ -30,17 +41,17 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
             // A lone leaf (or nothing) still needs a wide root node to hang from.
             wide.nodes.push(WideNode::empty());
             if bvh.triangle_count() > 0 {
-                let leaf = wide.push_leaf(bvh, root.first as usize, root.count as usize);
+                let leaf = wide.push_leaf(bvh, &corners, root.first as usize, root.count as usize);
                 set_child(&mut wide.nodes[0], 0, leaf, root);
             }
         } else {
-            wide.collapse(bvh, 0);
+            wide.collapse(bvh, &corners, 0);
         }
         wide
     }
 
     /// Writes the wide node for binary interior node `index` (and its subtree); returns its index.
-    fn collapse(&mut self, bvh: &Bvh, index: usize) -> u32 {
+    fn collapse(&mut self, bvh: &Bvh, corners: &impl Fn(usize) -> [Vec3; 3], index: usize) -> u32 {
         let nodes = bvh.nodes();
         let node = &nodes[index];
         let mut children = vec![node.first as usize, node.first as usize + 1];
@@ -60,9 +71,9 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
         for (slot, &child) in children.iter().enumerate() {
             let binary = &nodes[child];
             let reference = if binary.is_leaf() {
-                self.push_leaf(bvh, binary.first as usize, binary.count as usize)
+                self.push_leaf(bvh, corners, binary.first as usize, binary.count as usize)
             } else {
-                self.collapse(bvh, child)
+                self.collapse(bvh, corners, child)
             };
             set_child(&mut self.nodes[wide_index], slot, reference, binary);
         }
@@ -70,18 +81,18 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
     }
 
     /// Appends the blocks of a leaf holding triangle slots `first .. first + count`; returns its reference.
-    fn push_leaf(&mut self, bvh: &Bvh, first: usize, count: usize) -> u32 {
+    fn push_leaf(&mut self, bvh: &Bvh, corners: &impl Fn(usize) -> [Vec3; 3], first: usize, count: usize) -> u32 {
         let first_block = self.blocks.len();
         for start in (first..first + count).step_by(W) {
             let mut block = TriangleBlock { vertices: [[[0.0; W]; 3]; 3], ids: [0; W] };
             for lane in 0..W {
                 let slot = (start + lane).min(first + count - 1);
-                for (corner, p) in bvh.vertices[slot].iter().enumerate() {
+                for (corner, p) in corners(slot).iter().enumerate() {
                     for axis in 0..3 {
                         block.vertices[corner][axis][lane] = p[axis];
                     }
                 }
-                block.ids[lane] = bvh.triangle_ids[slot];
+                block.ids[lane] = bvh.triangle_id(slot);
             }
             self.blocks.push(block);
         }
