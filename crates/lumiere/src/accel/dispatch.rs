@@ -77,7 +77,7 @@ impl Accel {
     }
 
     /// Collapses the tree of `binary`, with the corners of leaf-order slot `i` at `corners(i)`.
-    fn collapse(binary: &Bvh, isa: Isa, corners: impl Fn(usize) -> [Vec3; 3]) -> Accel {
+    fn collapse(binary: &Bvh, isa: Isa, corners: impl Fn(usize) -> [Vec3; 3] + Sync) -> Accel {
         assert!(isa.is_supported(), "this CPU cannot run the {isa} kernels");
         let bvh = match isa {
             Isa::Portable => IsaBvh::Portable(WideBvh::from_tree(binary, corners)),

@@ -13,6 +13,7 @@ use crate::integrators::{CameraPacket, Integrator, PACKET, SampleContext};
 use crate::math::Ray;
 use crate::sampler::{SampleStream, Sampler};
 use crate::scene::camera::Camera;
+use crate::util::memory::ask_for_huge_pages;
 use crate::world::World;
 
 /// Tiles are small enough to balance two cores and to notice an interruption within milliseconds,
@@ -38,28 +39,10 @@ pub(super) struct Pass<'a> {
 /// 1024x768).
 pub(super) fn pass_buffer(width: u32, height: u32) -> Vec<[f32; 3]> {
     let buffer = vec![[0.0; 3]; width as usize * height as usize];
-    ask_for_huge_pages(&buffer);
+    // Its 2,300 4 KB pages, zeroed at their first touch, were a sixth of a hard-shadow render.
+    ask_for_huge_pages(buffer.as_ptr(), buffer.len());
     buffer
 }
-
-/// Asks the kernel to back `buffer` with 2 MB pages where it can. A zeroed allocation this large is
-/// a fresh mapping whose pages are zeroed at their first touch, one fault per 4 KB page: 2,300
-/// faults for a 1024x768 pass, measured at a sixth of a hard-shadow render's time in this VM. With
-/// transparent huge pages in `madvise` mode (the common default) one fault zeroes 2 MB. Only a
-/// request: the answer is ignored, and nothing but speed depends on it.
-#[cfg(target_os = "linux")]
-fn ask_for_huge_pages<T>(buffer: &[T]) {
-    const PAGE: usize = 4096;
-    let start = (buffer.as_ptr() as usize).next_multiple_of(PAGE);
-    let end = (buffer.as_ptr() as usize + size_of_val(buffer)) & !(PAGE - 1);
-    if end > start {
-        // SAFETY: the range lies inside `buffer`'s allocation; MADV_HUGEPAGE changes no contents.
-        unsafe { libc::madvise(start as *mut libc::c_void, end - start, libc::MADV_HUGEPAGE) };
-    }
-}
-
-#[cfg(not(target_os = "linux"))]
-fn ask_for_huge_pages<T>(_: &[T]) {}
 
 /// The camera ray of sample `sample` of pixel `(x, y)`, and that sample's random numbers with the
 /// pixel position already drawn from their first dimension (drawn even for pixel centres, so that

@@ -2,5 +2,6 @@
 //! and writer follows (atomic writes, capped reads, the memory left).
 
 pub mod hash;
+pub mod memory;
 pub mod read;
 pub mod write;

@@ -1,9 +1,15 @@
 //! From the binary tree to the wide one: each wide node takes its binary node's children and keeps
 //! opening the largest interior child (by surface area, the one most rays enter) until it has `W`.
+//!
+//! The leaves' triangle blocks are laid out in the binary tree's leaf order (spatially coherent)
+//! and filled in parallel before the nodes are collapsed: gathering every triangle's corners is
+//! most of the work, and the nodes then only refer to their leaves' blocks.
 
 use std::marker::PhantomData;
+use std::mem::MaybeUninit;
 
 use glam::Vec3;
+use rayon::prelude::*;
 
 use super::node::{TriangleBlock, WideNode};
 use super::{WideBvh, leaf};
@@ -19,7 +25,7 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
 
     /// Collapses the tree of `bvh`, reading the corners of the triangle in leaf-order slot `i`
     /// from `corners(i)` (so that the tree need not hold a copy of them).
-    pub(in crate::accel) fn from_tree(bvh: &Bvh, corners: impl Fn(usize) -> [Vec3; 3]) -> Self {
+    pub(in crate::accel) fn from_tree(bvh: &Bvh, corners: impl Fn(usize) -> [Vec3; 3] + Sync) -> Self {
         // The byte budgets of this width, checked at compile time.
         let () = WideNode::<W>::BYTE_BUDGET;
         let () = TriangleBlock::<W>::BYTE_BUDGET;
@@ -27,12 +33,12 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
         // kernel this CPU cannot run.
         assert!(L::supported(), "this CPU cannot run the kernel of a {W}-wide BVH");
 
-        // Every leaf's blocks, counted up front: growing the block array by doubling copied it
-        // and touched fresh memory over and over (a sixth of the bunny-1m build).
-        let block_count = bvh.nodes().iter().filter(|n| n.is_leaf()).map(|n| (n.count as usize).div_ceil(W)).sum();
+        let (blocks, first_block_of_leaf) = leaf_blocks::<W>(bvh, &corners);
+        // Each wide node takes at least one binary interior node: room for all, reserved, not touched.
+        let interior = bvh.nodes().len() - first_block_of_leaf.iter().filter(|&&b| b != NOT_A_LEAF).count();
         let mut wide = WideBvh {
-            nodes: Vec::new(),
-            blocks: Vec::with_capacity(block_count),
+            nodes: Vec::with_capacity(interior.max(1)),
+            blocks,
             triangle_count: bvh.triangle_count(),
             kernel: PhantomData,
         };
@@ -41,62 +47,120 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
             // A lone leaf (or nothing) still needs a wide root node to hang from.
             wide.nodes.push(WideNode::empty());
             if bvh.triangle_count() > 0 {
-                let leaf = wide.push_leaf(bvh, &corners, root.first as usize, root.count as usize);
+                let leaf = leaf::encode::<W>(0, wide.blocks.len());
                 set_child(&mut wide.nodes[0], 0, leaf, root);
             }
         } else {
-            wide.collapse(bvh, &corners, 0);
+            wide.collapse(bvh, &first_block_of_leaf, 0);
         }
         wide
     }
 
     /// Writes the wide node for binary interior node `index` (and its subtree); returns its index.
-    fn collapse(&mut self, bvh: &Bvh, corners: &impl Fn(usize) -> [Vec3; 3], index: usize) -> u32 {
+    fn collapse(&mut self, bvh: &Bvh, first_block_of_leaf: &[u32], index: usize) -> u32 {
         let nodes = bvh.nodes();
         let node = &nodes[index];
-        let mut children = vec![node.first as usize, node.first as usize + 1];
-        while children.len() < W {
-            let widest = children
-                .iter()
-                .enumerate()
-                .filter(|&(_, &c)| !nodes[c].is_leaf())
-                .max_by(|a, b| nodes[*a.1].bounds().half_area().total_cmp(&nodes[*b.1].bounds().half_area()));
-            let Some((slot, &open)) = widest else { break };
-            let first = nodes[open].first as usize;
-            children[slot] = first;
-            children.push(first + 1);
+        // The children so far and their half areas (those of leaves -1: never opened).
+        let area = |c: usize| if nodes[c].is_leaf() { -1.0 } else { nodes[c].bounds().half_area() };
+        let (mut children, mut areas) = ([0usize; W], [0f64; W]);
+        for (slot, child) in [node.first as usize, node.first as usize + 1].into_iter().enumerate() {
+            (children[slot], areas[slot]) = (child, area(child));
+        }
+        let mut count = 2;
+        while count < W {
+            // The widest interior child, the last of equals.
+            let mut widest = 0;
+            for slot in 1..count {
+                if areas[slot] >= areas[widest] {
+                    widest = slot;
+                }
+            }
+            if areas[widest] < 0.0 {
+                break;
+            }
+            let first = nodes[children[widest]].first as usize;
+            (children[widest], areas[widest]) = (first, area(first));
+            (children[count], areas[count]) = (first + 1, area(first + 1));
+            count += 1;
         }
         let wide_index = self.nodes.len();
         self.nodes.push(WideNode::empty());
-        for (slot, &child) in children.iter().enumerate() {
+        for (slot, &child) in children[..count].iter().enumerate() {
             let binary = &nodes[child];
             let reference = if binary.is_leaf() {
-                self.push_leaf(bvh, corners, binary.first as usize, binary.count as usize)
+                let first_block = first_block_of_leaf[child] as usize;
+                leaf::encode::<W>(first_block, (binary.count as usize).div_ceil(W))
             } else {
-                self.collapse(bvh, corners, child)
+                self.collapse(bvh, first_block_of_leaf, child)
             };
             set_child(&mut self.nodes[wide_index], slot, reference, binary);
         }
         wide_index as u32
     }
+}
 
-    /// Appends the blocks of a leaf holding triangle slots `first .. first + count`; returns its reference.
-    fn push_leaf(&mut self, bvh: &Bvh, corners: &impl Fn(usize) -> [Vec3; 3], first: usize, count: usize) -> u32 {
-        let first_block = self.blocks.len();
-        for start in (first..first + count).step_by(W) {
-            let mut block = TriangleBlock { vertices: [[[0.0; W]; 3]; 3], ids: [0; W] };
-            for lane in 0..W {
-                let slot = (start + lane).min(first + count - 1);
-                for (corner, p) in corners(slot).iter().enumerate() {
-                    for axis in 0..3 {
-                        block.vertices[corner][axis][lane] = p[axis];
-                    }
-                }
-                block.ids[lane] = bvh.triangle_id(slot);
-            }
-            self.blocks.push(block);
+/// `leaf_blocks`'s entry for an interior node.
+const NOT_A_LEAF: u32 = u32::MAX;
+
+/// The triangle blocks of every leaf of `bvh`, leaf after leaf in slot order, and the first block
+/// of each leaf by binary node index (`NOT_A_LEAF` for the others).
+fn leaf_blocks<const W: usize>(
+    bvh: &Bvh,
+    corners: &(impl Fn(usize) -> [Vec3; 3] + Sync),
+) -> (Vec<TriangleBlock<W>>, Vec<u32>) {
+    let nodes = bvh.nodes();
+    let mut first_block_of_leaf = vec![NOT_A_LEAF; nodes.len()];
+    // Leaves in slot order: a depth-first walk, left child first, meets them as the build numbered them.
+    let mut leaves = Vec::new();
+    let mut block_count = 0;
+    let mut stack = vec![0usize];
+    while let Some(index) = stack.pop() {
+        let node = &nodes[index];
+        if node.is_leaf() {
+            first_block_of_leaf[index] = block_count as u32;
+            block_count += (node.count as usize).div_ceil(W);
+            leaves.push((node.first as usize, node.count as usize));
+        } else if bvh.triangle_count() > 0 {
+            stack.push(node.first as usize + 1);
+            stack.push(node.first as usize);
         }
-        leaf::encode::<W>(first_block, self.blocks.len() - first_block)
+    }
+    let mut blocks = Vec::with_capacity(block_count);
+    // Each leaf's piece of the uninitialised array, filled in parallel (first touches included).
+    let mut pieces = Vec::with_capacity(leaves.len());
+    let mut rest = &mut blocks.spare_capacity_mut()[..block_count];
+    for &(first, count) in &leaves {
+        let (piece, tail) = rest.split_at_mut(count.div_ceil(W));
+        pieces.push((piece, first, count));
+        rest = tail;
+    }
+    pieces.into_par_iter().for_each(|(piece, first, count)| fill_leaf(bvh, corners, piece, first, count));
+    // SAFETY: the pieces cover the first `block_count` entries, and `fill_leaf` wrote each of them.
+    unsafe { blocks.set_len(block_count) };
+    (blocks, first_block_of_leaf)
+}
+
+/// Writes the blocks of the leaf holding triangle slots `first .. first + count`; a last block
+/// not full repeats the leaf's last triangle.
+fn fill_leaf<const W: usize>(
+    bvh: &Bvh,
+    corners: &impl Fn(usize) -> [Vec3; 3],
+    piece: &mut [MaybeUninit<TriangleBlock<W>>],
+    first: usize,
+    count: usize,
+) {
+    for (block_slot, start) in piece.iter_mut().zip((first..first + count).step_by(W)) {
+        let mut block = TriangleBlock { vertices: [[[0.0; W]; 3]; 3], ids: [0; W] };
+        for lane in 0..W {
+            let slot = (start + lane).min(first + count - 1);
+            for (corner, p) in corners(slot).iter().enumerate() {
+                for axis in 0..3 {
+                    block.vertices[corner][axis][lane] = p[axis];
+                }
+            }
+            block.ids[lane] = bvh.triangle_id(slot);
+        }
+        block_slot.write(block);
     }
 }
 

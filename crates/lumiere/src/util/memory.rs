@@ -1,0 +1,21 @@
+//! Fresh memory: large buffers a render or a build writes once, whose first touch is a page fault
+//! per 4 KB page that zeroes it (measured at 1.3 GB/s in this project's VM, against 7 GB/s for
+//! writing memory already touched).
+
+/// Asks the kernel to back the `len` values of type `T` at `start`, not yet touched, with 2 MB
+/// pages where it can: with transparent huge pages in `madvise` mode (the common default) one
+/// fault then zeroes 2 MB. Only a request: the answer is ignored, and nothing but speed depends
+/// on it.
+#[cfg(target_os = "linux")]
+pub fn ask_for_huge_pages<T>(start: *const T, len: usize) {
+    const PAGE: usize = 4096;
+    let begin = (start as usize).next_multiple_of(PAGE);
+    let end = (start as usize + len * size_of::<T>()) & !(PAGE - 1);
+    if end > begin {
+        // SAFETY: the range lies inside the caller's allocation; MADV_HUGEPAGE changes no contents.
+        unsafe { libc::madvise(begin as *mut libc::c_void, end - begin, libc::MADV_HUGEPAGE) };
+    }
+}
+
+#[cfg(not(target_os = "linux"))]
+pub fn ask_for_huge_pages<T>(_: *const T, _: usize) {}
