@@ -359,14 +359,17 @@ fn plucker_block(origin: Vec3, pending: &arrayvec_like::Pending) -> PluckerBlock
     };
     // Projected area over squared distance, |n . (c - o)| / |c - o|^3 with |n| twice the area, of
     // the real lanes: for ordering only.
+    // A loop over the four lanes (vectorised), each with `Vec3::length` and `Vec3::dot`'s operations.
     let centroid = [0, 1, 2].map(|k| ((a[k] + b[k] + c[k]) * F32x4::splat(1.0 / 3.0)).to_array());
-    for lane in 0..pending.len() {
+    let mut projected = [0.0f32; 4];
+    for (lane, value) in projected.iter_mut().enumerate() {
         let [cx, cy, cz] = centroid.map(|axis| axis[lane]);
-        let to_centroid = Vec3::new(cx, cy, cz);
-        let n = Vec3::new(block.normal[0][lane], block.normal[1][lane], block.normal[2][lane]);
-        let distance = to_centroid.length().max(f32::MIN_POSITIVE);
-        let projected = n.dot(to_centroid).abs() / (distance * distance * distance);
-        block.solid_angle += if projected.is_finite() { projected } else { f32::MAX };
+        let [nx, ny, nz] = block.normal.map(|axis| axis[lane]);
+        let distance = (cx * cx + cy * cy + cz * cz).sqrt().max(f32::MIN_POSITIVE);
+        *value = (nx * cx + ny * cy + nz * cz).abs() / (distance * distance * distance);
+    }
+    for &value in &projected[..pending.len()] {
+        block.solid_angle += if value.is_finite() { value } else { f32::MAX };
     }
     block
 }
