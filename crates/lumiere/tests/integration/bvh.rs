@@ -333,3 +333,35 @@ fn origin_batches_never_leak_through_a_closed_mesh() {
         }
     }
 }
+
+/// A direction component of -0.0 is a zero component like +0.0: a ray from inside that slab
+/// enters the boxes around it (its reciprocal is a huge negative number, so the slab test must
+/// take the entry plane from the reciprocal's sign, not from `d >= 0`).
+#[test]
+fn negative_zero_directions_enter_boxes() {
+    // A floor of many triangles, so that the tree has boxes to enter.
+    let (mut positions, mut indices) = (Vec::new(), Vec::new());
+    for i in 0..8 {
+        for j in 0..8 {
+            let (x, y) = (i as f32, j as f32);
+            let base = positions.len() as u32;
+            positions.extend([Vec3::new(x, y, 0.0), Vec3::new(x + 1.0, y, 0.0), Vec3::new(x, y + 1.0, 0.0)]);
+            indices.push([base, base + 1, base + 2]);
+        }
+    }
+    for dir in [Vec3::new(-0.0, -0.0, -1.0), Vec3::new(-0.0, 0.0, -1.0), Vec3::new(0.0, -0.0, -1.0)] {
+        for origin in [Vec3::new(2.25, 3.25, 5.0), Vec3::new(6.1, 0.2, 1.0)] {
+            let ray = Ray::new(origin, dir);
+            let expected = brute_force(&positions, &indices, &ray);
+            assert!(expected.is_some());
+            let bvh = Bvh::build(&positions, &indices, BuildPreset::Default);
+            assert_eq!(bvh.intersect(&ray), expected, "binary {ray:?}");
+            for isa in Isa::supported() {
+                let accel = Accel::build(&positions, &indices, BuildPreset::Default, isa);
+                assert_eq!(accel.intersect(&ray), expected, "{isa} {ray:?}");
+                assert!(accel.occluded(&ray), "{isa} {ray:?}");
+                assert_eq!(accel.intersect_packet(&[ray; 16], 0xffff)[3], expected, "{isa} packet {ray:?}");
+            }
+        }
+    }
+}

@@ -18,6 +18,7 @@ use crate::accel::Hit;
 use crate::accel::slab::{BOX_EXPANSION, PRUNE_SLACK, safe_reciprocal};
 use crate::geometry::triangle::{CANCELLATION_ERROR, WatertightRay, dominant_axis, intersect_triangle};
 use crate::math::Ray;
+use glam::Vec3;
 
 /// What rays must share to travel in one packet: the sign of each direction component (which slab
 /// plane is entered first) and the dominant axis (the watertight test's axis permutation follows
@@ -26,17 +27,21 @@ use crate::math::Ray;
 pub struct PacketKey(u8);
 
 impl PacketKey {
-    /// The key of a ray whose direction has a NaN: such a ray is traced alone.
+    /// The key of a ray whose direction has a NaN or is zero: such a ray is traced alone.
     pub const ALONE: PacketKey = PacketKey(u8::MAX);
 
+    /// The key of `ray`: sign bits as `traverse.rs`'s `near_row` reads them (-0.0 negative). The
+    /// dominant component is never zero but for a zero direction, traced alone, so its sign bit
+    /// is also `WatertightRay`'s `d[kz] < 0.0`.
     #[inline(always)]
     pub fn of(ray: &Ray) -> PacketKey {
         let d = ray.dir;
-        if d.is_nan() {
+        if d.is_nan() || d == Vec3::ZERO {
             return PacketKey::ALONE;
         }
         let kz = dominant_axis(d) as u8;
-        let negative = u8::from(d.x < 0.0) | u8::from(d.y < 0.0) << 1 | u8::from(d.z < 0.0) << 2;
+        let negative =
+            [d.x, d.y, d.z].iter().enumerate().fold(0u8, |m, (axis, v)| m | u8::from(v.is_sign_negative()) << axis);
         PacketKey(negative | kz << 3)
     }
 

@@ -45,6 +45,15 @@ impl<const W: usize> Stack<W> {
     }
 }
 
+/// The box row (min x, y, z, then max x, y, z) of the plane a ray with direction component `d` on
+/// `axis` enters first: the max plane when its reciprocal (`safe_reciprocal`, which keeps the
+/// sign) is negative, -0.0 included (`d >= 0.0` would take the min plane with a reciprocal of
+/// -1e30, and a ray from inside that slab would miss every box around it).
+#[inline(always)]
+pub(super) fn near_row(d: f32, axis: usize) -> usize {
+    if d.is_sign_negative() { axis + 3 } else { axis }
+}
+
 /// The ray, splatted for the box tests.
 struct BoxRay<L> {
     /// Per axis, the bounds row that holds the entry (near) plane: min when the direction is positive.
@@ -62,7 +71,7 @@ impl<L> BoxRay<L> {
         let d = ray.dir.to_array();
         let o = ray.origin.to_array();
         BoxRay {
-            near_row: [0, 1, 2].map(|a| if d[a] >= 0.0 { a } else { a + 3 }),
+            near_row: [0, 1, 2].map(|a| near_row(d[a], a)),
             origin: o.map(L::splat),
             inv_dir: d.map(|v| L::splat(safe_reciprocal(v))),
         }
