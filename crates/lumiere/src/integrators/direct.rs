@@ -3,7 +3,7 @@ use glam::{Vec2, Vec3};
 use super::{SampleContext, ShadesClosestHit, shading_frame};
 use crate::accel::{Hit, OriginBatch, Region};
 use crate::geometry::surface::SurfacePoint;
-use crate::lights::{AreaLight, LightSample, LightSelection};
+use crate::lights::{AreaLight, LightSample, LightSelection, LightSet};
 use crate::materials::Bsdf;
 use crate::math::{Frame, Ray};
 use crate::sampler::PointSet;
@@ -73,31 +73,22 @@ impl<B: Bsdf> Receiver<'_, B> {
     ) -> Vec3 {
         let lights = world.lights();
         let origin = batch.origin();
+        let lambertian = self.bsdf.lambertian_eval(self.wo);
+        if lambertian == Some(Vec3::ZERO) {
+            // A zero BSDF: `unshadowed` refuses every sample, no ray is traced.
+            return sum;
+        }
         for first in (0..n).step_by(LANES) {
             // Polled as often as one sample at a time polled it (every `STOP_POLL` samples).
             if ctx.must_stop(first + LANES as u32 - 1) {
                 break;
             }
             let count = (n - first).min(LANES as u32) as usize;
-            // Three loops: the random numbers, the light points (plain arithmetic; both
-            // vectorised), then the BSDF, a call per lane, which would keep the others scalar if
-            // they shared its loop.
             let points: [Vec2; LANES] = points.get_2d_lanes(first);
-            let mut samples = [None; LANES];
-            for (sample, u) in samples.iter_mut().zip(points) {
-                *sample = lights.sample_li_on(light, self.surface.p, u).filter(|s| self.faces(s));
-            }
-            let mut contributions = [Vec3::ZERO; LANES];
-            let mut segments = [[0.0; LANES]; 3];
-            let mut traced = 0u32;
-            for (lane, sample) in samples.iter().enumerate().take(count) {
-                let Some(sample) = sample else { continue };
-                let Some(contribution) = self.unshadowed(sample) else { continue };
-                contributions[lane] = contribution;
-                // `Ray::segment(origin, target)`: the direction is the whole segment, tmax 1.
-                [segments[0][lane], segments[1][lane], segments[2][lane]] = (sample.target - origin).to_array();
-                traced |= 1 << lane;
-            }
+            let (contributions, segments, traced) = match lambertian {
+                Some(f) => self.lambertian_lanes(f, &lights.lights()[light as usize], &points, count, origin),
+                None => self.bsdf_lanes(lights, light, &points, count, origin),
+            };
             ctx.rays += u64::from(traced.count_ones());
             let visible = traced & !world.occluded_lanes_in_batch(batch, &segments, 1.0, traced);
             for (lane, contribution) in contributions.iter().enumerate() {
@@ -107,6 +98,89 @@ impl<B: Bsdf> Receiver<'_, B> {
             }
         }
         sum
+    }
+}
+
+impl<B: Bsdf> Receiver<'_, B> {
+    /// The contributions (before visibility) and shadow segments of the light points of `light`
+    /// drawn from `points` (the first `count` of them), and the lanes that need a shadow ray. Two
+    /// loops: the light points (plain arithmetic, vectorised), then the BSDF, a call per lane,
+    /// which would keep the points scalar if they shared its loop.
+    #[inline(always)]
+    fn bsdf_lanes(
+        &self,
+        lights: &LightSet,
+        light: u32,
+        points: &[Vec2; LANES],
+        count: usize,
+        origin: Vec3,
+    ) -> ([Vec3; LANES], [[f32; LANES]; 3], u32) {
+        let mut samples = [None; LANES];
+        for (sample, &u) in samples.iter_mut().zip(points) {
+            *sample = lights.sample_li_on(light, self.surface.p, u).filter(|s| self.faces(s));
+        }
+        let mut contributions = [Vec3::ZERO; LANES];
+        let mut segments = [[0.0; LANES]; 3];
+        let mut traced = 0u32;
+        for (lane, sample) in samples.iter().enumerate().take(count) {
+            let Some(sample) = sample else { continue };
+            let Some(contribution) = self.unshadowed(sample) else { continue };
+            contributions[lane] = contribution;
+            // `Ray::segment(origin, target)`: the direction is the whole segment, tmax 1.
+            [segments[0][lane], segments[1][lane], segments[2][lane]] = (sample.target - origin).to_array();
+            traced |= 1 << lane;
+        }
+        (contributions, segments, traced)
+    }
+
+    /// [`Receiver::bsdf_lanes`] for a diffuse receiver, whose BSDF is `f` wherever `wi` is above
+    /// its shading normal: everything in one loop over the lanes, SoA, which the ISA vectorises
+    /// whole. Each lane does the operations of `sample_uniform_triangle`, `shadow_target`,
+    /// `sample_li_on`, `faces` and `unshadowed` in their order (glam's `dot` and
+    /// `length_squared` sum x, y, then z), so the bits are theirs (the golden images check it).
+    #[inline(always)]
+    fn lambertian_lanes(
+        &self,
+        f: Vec3,
+        light: &AreaLight,
+        points: &[Vec2; LANES],
+        count: usize,
+        origin: Vec3,
+    ) -> ([Vec3; LANES], [[f32; LANES]; 3], u32) {
+        let [p0, p1, p2] = light.shadow_targets.map(|t| t.to_array());
+        let (p, o) = (self.surface.p.to_array(), origin.to_array());
+        let (ns, ng, normal) = (self.surface.ns, self.surface.ng, light.normal);
+        // `f * li * (cos / pdf)` multiplies `f * li` first.
+        let scale = (f * light.emission).to_array();
+        let mut weights = [0.0f32; LANES];
+        let mut segments = [[0.0; LANES]; 3];
+        let mut traced = 0u32;
+        for (lane, u) in points.iter().enumerate() {
+            let s = u.x.sqrt();
+            let (b0, b1) = (1.0 - s, u.y * s);
+            let b2 = 1.0 - b0 - b1;
+            let target = [0, 1, 2].map(|c| b0 * p0[c] + b1 * p1[c] + b2 * p2[c]);
+            let v = [0, 1, 2].map(|c| target[c] - p[c]);
+            let dist2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+            let dist = dist2.sqrt();
+            let inv_dist = 1.0 / dist;
+            let wi = v.map(|c| c * inv_dist);
+            let cos_light_dist = -(normal.x * v[0] + normal.y * v[1] + normal.z * v[2]);
+            let sampled = !(cos_light_dist <= 0.0 || dist2 <= 0.0);
+            let pdf = dist2 * dist / (cos_light_dist * light.area);
+            let cos_surface = ns.x * wi[0] + ns.y * wi[1] + ns.z * wi[2];
+            let cos_geometric = ng.x * wi[0] + ng.y * wi[1] + ng.z * wi[2];
+            let faces = !(cos_surface <= 0.0 || cos_geometric <= 0.0);
+            // `eval` is `f` for `wi.z > 0` in the shading frame, whose z is `ns`: `cos_surface`.
+            let lit = sampled & faces & (cos_surface > 0.0) & (lane < count);
+            weights[lane] = cos_surface / pdf;
+            for c in 0..3 {
+                segments[c][lane] = target[c] - o[c];
+            }
+            traced |= u32::from(lit) << lane;
+        }
+        let contributions = weights.map(|w| Vec3::from_array(scale.map(|k| k * w)));
+        (contributions, segments, traced)
     }
 }
 

@@ -19,6 +19,11 @@ impl Bsdf for Lambert {
     }
 
     #[inline]
+    fn lambertian_eval(&self, wo: Vec3) -> Option<Vec3> {
+        Some(self.eval(wo, Vec3::Z))
+    }
+
+    #[inline]
     fn sample(&self, wo: Vec3, u: Vec2) -> Option<BsdfSample> {
         if wo.z <= 0.0 {
             return None;

@@ -86,6 +86,12 @@ pub trait Bsdf {
     /// The surface's colour: the fraction of light it reflects at normal incidence, per channel.
     /// What the `materials` mode shows and what a denoiser's albedo buffer holds.
     fn albedo(&self) -> Vec3;
+    /// For a purely diffuse lobe, the `f` that `eval(wo, wi)` returns for every `wi` with
+    /// `wi.z > 0` (and it returns 0 for the others): lets light sampling evaluate many `wi` at
+    /// once. `None` for lobes that depend on `wi`.
+    fn lambertian_eval(&self, _wo: Vec3) -> Option<Vec3> {
+        None
+    }
 }
 
 /// The BSDF of any material, as [`Material::bsdf`] builds it: one variant per lobe, dispatched by
@@ -152,5 +158,10 @@ impl Bsdf for MaterialBsdf {
     #[inline]
     fn albedo(&self) -> Vec3 {
         dispatch!(self, lobe => lobe.albedo())
+    }
+
+    #[inline]
+    fn lambertian_eval(&self, wo: Vec3) -> Option<Vec3> {
+        dispatch!(self, lobe => lobe.lambertian_eval(wo))
     }
 }
