@@ -1,5 +1,6 @@
-//! Textures: image files decoded once, when the world is built, into linear `f32` RGB (and alpha
-//! where the file has one), and looked up with bilinear filtering and repeat wrapping.
+//! Textures: image files decoded once, when the world is built, into linear RGB (8-bit files keep
+//! their codes and decode them through a table at each lookup; alpha where the file has one), and
+//! looked up with bilinear filtering and repeat wrapping.
 //!
 //! * **Colour.** PNG and JPEG store sRGB-encoded values; each channel is decoded with the exact
 //!   sRGB curve (IEC 61966-2-1: linear below 0.04045, a 2.4 power above), so texture values are
@@ -44,8 +45,42 @@ pub struct Texture {
     width: u32,
     height: u32,
     /// Row-major from the top row of the image, as stored in the file.
-    rgb: Vec<Vec3>,
+    rgb: Texels,
     alpha: Option<Vec<f32>>,
+}
+
+/// The colour of every texel: the 8-bit sRGB codes of most files, decoded through the table at
+/// each lookup (the same `f32` values, in a third of the memory: path tracing reads texels at
+/// random, and their cache misses were most of a textured scene's shading), or linear `f32` (16-bit
+/// files, [`Texture::from_linear`]).
+#[derive(Clone, Debug, PartialEq)]
+enum Texels {
+    /// RGB codes and a padding byte, so that a texel is one aligned 4-byte load.
+    Srgb8 {
+        codes: Vec<[u8; 4]>,
+        table: &'static [f32; 256],
+    },
+    Linear(Vec<Vec3>),
+}
+
+impl Texels {
+    #[inline]
+    fn get(&self, i: usize) -> Vec3 {
+        match self {
+            Texels::Srgb8 { codes, table } => {
+                let [r, g, b, _] = codes[i];
+                Vec3::new(table[r as usize], table[g as usize], table[b as usize])
+            }
+            Texels::Linear(rgb) => rgb[i],
+        }
+    }
+
+    fn memory_bytes(&self) -> usize {
+        match self {
+            Texels::Srgb8 { codes, .. } => codes.len() * 4,
+            Texels::Linear(rgb) => rgb.len() * std::mem::size_of::<Vec3>(),
+        }
+    }
 }
 
 impl Texture {
@@ -77,7 +112,12 @@ impl Texture {
     pub fn from_linear(width: u32, height: u32, rgb: Vec<Vec3>, alpha: Option<Vec<f32>>) -> Option<Texture> {
         let n = width as u64 * height as u64;
         let sizes_fit = rgb.len() as u64 == n && alpha.as_ref().is_none_or(|a| a.len() as u64 == n);
-        (sizes_fit && check_size(width, height).is_ok()).then_some(Texture { width, height, rgb, alpha })
+        (sizes_fit && check_size(width, height).is_ok()).then_some(Texture {
+            width,
+            height,
+            rgb: Texels::Linear(rgb),
+            alpha,
+        })
     }
 
     /// Converts a decoded image, whatever its channels and depth, to linear RGB(A).
@@ -89,7 +129,7 @@ impl Texture {
             // 16 bits per channel (PNG): decode each value exactly.
             let decode = |c: u16| srgb_to_linear(c as f32 / 65535.0);
             let pixels = image.into_rgba16();
-            pixels
+            let rgb = pixels
                 .pixels()
                 .map(|p| {
                     if has_alpha {
@@ -97,19 +137,20 @@ impl Texture {
                     }
                     Vec3::new(decode(p[0]), decode(p[1]), decode(p[2]))
                 })
-                .collect()
+                .collect();
+            Texels::Linear(rgb)
         } else {
-            let table = srgb_table();
             let pixels = image.into_rgba8();
-            pixels
+            let codes = pixels
                 .pixels()
                 .map(|p| {
                     if has_alpha {
                         alpha.push(p[3] as f32 / 255.0);
                     }
-                    Vec3::new(table[p[0] as usize], table[p[1] as usize], table[p[2] as usize])
+                    [p[0], p[1], p[2], 0]
                 })
-                .collect()
+                .collect();
+            Texels::Srgb8 { codes, table: srgb_table() }
         };
         Texture { width, height, rgb, alpha: has_alpha.then_some(alpha) }
     }
@@ -132,14 +173,14 @@ impl Texture {
 
     /// The bytes the texels take in memory.
     pub fn memory_bytes(&self) -> usize {
-        self.rgb.len() * std::mem::size_of::<Vec3>() + self.alpha.as_ref().map_or(0, |a| a.len() * 4)
+        self.rgb.memory_bytes() + self.alpha.as_ref().map_or(0, |a| a.len() * 4)
     }
 
     /// The linear colour of texel `(x, y)`, column `x` and row `y` counted from the top of the
     /// image as stored in the file; coordinates wrap around.
     #[inline]
     pub fn texel(&self, x: u32, y: u32) -> Vec3 {
-        self.rgb[self.index(x as i64, y as i64)]
+        self.rgb.get(self.index(x as i64, y as i64))
     }
 
     /// The bilinearly filtered colour at texture coordinates `uv` (OBJ convention: `v = 0` is the
@@ -147,7 +188,8 @@ impl Texture {
     #[inline]
     pub fn sample(&self, uv: Vec2) -> Vec3 {
         let [(i00, w00), (i10, w10), (i01, w01), (i11, w11)] = self.footprint(uv);
-        self.rgb[i00] * w00 + self.rgb[i10] * w10 + self.rgb[i01] * w01 + self.rgb[i11] * w11
+        let rgb = &self.rgb;
+        rgb.get(i00) * w00 + rgb.get(i10) * w10 + rgb.get(i01) * w01 + rgb.get(i11) * w11
     }
 
     /// The bilinearly filtered alpha at `uv`; 1 (opaque) for images without alpha.
@@ -163,7 +205,7 @@ impl Texture {
         // Continuous texel coordinates, with texel centres at integers; rows from the top.
         let x = wrap_unit(uv.x) * self.width as f32 - 0.5;
         let y = (1.0 - wrap_unit(uv.y)) * self.height as f32 - 0.5;
-        let (x0, y0) = (x.floor(), y.floor());
+        let (x0, y0) = (floor(x), floor(y));
         let (fx, fy) = (x - x0, y - y0);
         let (x0, y0) = (x0 as i64, y0 as i64);
         [
@@ -177,17 +219,44 @@ impl Texture {
     /// The storage index of texel `(x, y)`, wrapped into the image.
     #[inline]
     fn index(&self, x: i64, y: i64) -> usize {
-        let x = x.rem_euclid(self.width as i64) as usize;
-        let y = y.rem_euclid(self.height as i64) as usize;
-        y * self.width as usize + x
+        wrap_texel(y, self.height) * self.width as usize + wrap_texel(x, self.width)
     }
+}
+
+/// `i.rem_euclid(n)`. The footprint's texels lie in `-1 ..= n` (the coordinates come wrapped into
+/// `[0, 1]`), which two comparisons wrap: the integer division was a quarter of the staircase's
+/// render, eight of them per lookup.
+#[inline]
+fn wrap_texel(i: i64, n: u32) -> usize {
+    let n = i64::from(n);
+    let wrapped = if i < 0 {
+        i + n
+    } else if i >= n {
+        i - n
+    } else {
+        i
+    };
+    if (0..n).contains(&wrapped) { wrapped as usize } else { i.rem_euclid(n) as usize }
+}
+
+/// `t.floor()` for a finite `t`, without the libm call it compiles to on x86-64's baseline (SSE2
+/// has no rounding instruction): truncate, and step down for negative non-integers. Values of
+/// magnitude `2^23` and above are integers already. The result's sign of zero may differ from
+/// `floor`'s (`-0.0` gives `0.0`), which no use here can see.
+#[inline]
+fn floor(t: f32) -> f32 {
+    if t.abs() >= 8_388_608.0 {
+        return t;
+    }
+    let truncated = t as i32 as f32;
+    if truncated > t { truncated - 1.0 } else { truncated }
 }
 
 /// `t` wrapped into `[0, 1]` (repeat); 0 for NaN and infinities. The result can be exactly 1 for
 /// tiny negative `t` (`1 − 1e-9` rounds up), which the index wrapping handles.
 #[inline]
 fn wrap_unit(t: f32) -> f32 {
-    if t.is_finite() { t - t.floor() } else { 0.0 }
+    if t.is_finite() { t - floor(t) } else { 0.0 }
 }
 
 /// Refuses empty images and those of more than [`MAX_TEXELS`] texels.
@@ -325,4 +394,28 @@ fn read_texture(path: &Path) -> Result<Texture, String> {
     }
     let bytes = crate::util::read::read_regular_file(path).map_err(|e| e.to_string())?;
     Texture::decode(&bytes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{floor, wrap_texel};
+
+    #[test]
+    fn floor_is_f32_floor() {
+        let mut values = vec![0.0f32, -0.0, 0.5, -0.5, 1.0, -1.0, 2.999_999_8, -2.999_999_8, 1e-30, -1e-30];
+        values.extend([8_388_607.5f32, -8_388_607.5, 8_388_608.0, -8_388_609.0, 1e30, -1e30, f32::MAX, f32::MIN]);
+        values.extend((0..10_000).map(|i| (i as f32 - 5000.0) * 0.37));
+        for t in values {
+            assert_eq!(floor(t), t.floor(), "{t}");
+        }
+    }
+
+    #[test]
+    fn wrap_texel_is_rem_euclid() {
+        for n in [1u32, 2, 3, 7, 1024] {
+            for i in -3 * i64::from(n) - 2..3 * i64::from(n) + 2 {
+                assert_eq!(wrap_texel(i, n), i.rem_euclid(i64::from(n)) as usize, "{i} mod {n}");
+            }
+        }
+    }
 }
