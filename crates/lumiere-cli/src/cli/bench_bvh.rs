@@ -97,7 +97,7 @@ pub fn run(args: &BenchBvhArgs) -> Result<()> {
         }
     }
     output::print(
-        "| scene | threads | triangles | load ms | build ms | nodes binary / 4-wide | SAH fast / default / high | bytes/tri | peak RSS MiB |",
+        "| scene | threads | triangles | load ms | build ms | nodes binary / wide | SAH fast / default / high | bytes/tri | peak RSS MiB |",
     )?;
     output::print("|---|---|---|---|---|---|---|---|---|")?;
     for row in &builds {
