@@ -14,7 +14,8 @@ use super::{Bvh4, Hit, Isa, OriginBatch, Region, TraversalStats};
 use crate::math::Ray;
 
 /// Fewer rays than this sharing a [`PacketKey`] are traced one by one: a packet's walk costs about
-/// what its widest lane's does, so a handful of rays do not pay for it.
+/// what the walk of the union of its rays' paths does, which a handful of rays do not amortise.
+/// A choice, not tuned.
 const MIN_PACKET_RAYS: u32 = 4;
 
 /// A BVH built for one instruction set.
@@ -240,6 +241,7 @@ impl Accel {
         live: u32,
         mut packet: impl FnMut(&RayPacket<N>, u32),
     ) -> u32 {
+        const { assert!(N <= 32, "lane masks are u32") };
         let keys: [PacketKey; N] = std::array::from_fn(|lane| PacketKey::of(&rays[lane]));
         let mut alone = 0;
         let mut remaining = live;

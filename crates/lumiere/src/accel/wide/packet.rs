@@ -10,6 +10,8 @@
 //! planes (direction signs) and the triangle test's axis permutation; [`PacketKey`] says which rays
 //! do, and callers trace the others alone.
 
+use glam::Vec3;
+
 use super::WideBvh;
 use super::leaf::{self, LEAF_BIT};
 use super::node::{EMPTY_CHILD, TriangleBlock, WideNode};
@@ -18,7 +20,6 @@ use crate::accel::Hit;
 use crate::accel::slab::{BOX_EXPANSION, PRUNE_SLACK, safe_reciprocal};
 use crate::geometry::triangle::{CANCELLATION_ERROR, WatertightRay, dominant_axis, intersect_triangle};
 use crate::math::Ray;
-use glam::Vec3;
 
 /// What rays must share to travel in one packet: the sign of each direction component (which slab
 /// plane is entered first) and the dominant axis (the watertight test's axis permutation follows
@@ -376,7 +377,6 @@ impl<const W: usize, L> WideBvh<W, L> {
 
 #[cfg(test)]
 mod tests {
-    use glam::Vec3;
 
     use super::*;
 
