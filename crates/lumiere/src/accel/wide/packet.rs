@@ -377,7 +377,6 @@ impl<const W: usize, L> WideBvh<W, L> {
 
 #[cfg(test)]
 mod tests {
-
     use super::*;
 
     /// The key's permutation and the packet's shears are `WatertightRay`'s, for directions along
