@@ -22,7 +22,7 @@ impl Integrator for Shadows {
         };
         let mut sum = Vec3::ZERO;
         for light in world.lights().lights() {
-            if let Some((segment, contribution)) = receiver.unshadowed(light) {
+            if let Some((segment, contribution)) = receiver.unshadowed(light, &LightPoint::of(light)) {
                 ctx.rays += 1;
                 if !world.occluded(&segment) {
                     sum += contribution;
@@ -54,9 +54,10 @@ impl Integrator for Shadows {
         let mut segments = camera.rays;
         let mut contributions = [Vec3::ZERO; PACKET];
         for light in world.lights().lights() {
+            let point = LightPoint::of(light);
             let mut traced = 0u32;
             for (lane, receiver) in receivers.iter().enumerate() {
-                if let Some((segment, contribution)) = receiver.as_ref().and_then(|r| r.unshadowed(light)) {
+                if let Some((segment, contribution)) = receiver.as_ref().and_then(|r| r.unshadowed(light, &point)) {
                     (segments[lane], contributions[lane]) = (segment, contribution);
                     traced |= 1 << lane;
                 }
@@ -76,11 +77,28 @@ impl Integrator for Shadows {
     }
 }
 
+/// Where a light triangle acts as a point light: its centroid, and the point on its shadow-target
+/// triangle the shadow segments end at. The same for every receiver: computed once per light.
+struct LightPoint {
+    centroid: Vec3,
+    target: Vec3,
+}
+
+impl LightPoint {
+    #[inline]
+    fn of(light: &AreaLight) -> LightPoint {
+        LightPoint { centroid: light.centroid(), target: light.shadow_target(Vec3::splat(1.0 / 3.0)) }
+    }
+}
+
 /// A surface point seen by a camera ray, ready to be lit.
 #[derive(Clone, Copy)]
 struct Receiver {
     surface: SurfacePoint,
     bsdf: MaterialBsdf,
+    /// The BSDF's value wherever it is not zero, for a diffuse surface (`Bsdf::lambertian_eval`):
+    /// no evaluation per light then.
+    lambertian: Option<Vec3>,
     frame: Frame,
     wo: Vec3,
 }
@@ -98,15 +116,15 @@ impl Receiver {
         let surface = world.surface(ray, &hit);
         let bsdf = world.bsdf(&surface);
         let (frame, wo) = shading_frame(surface.ns, ray);
-        Ok(Receiver { surface, bsdf, frame, wo })
+        Ok(Receiver { surface, bsdf, lambertian: bsdf.lambertian_eval(wo), frame, wo })
     }
 
     /// The shadow ray towards `light`'s centroid and the light it brings if nothing blocks it, or
     /// `None` when the light cannot reach the surface (no ray is traced then).
     #[inline]
-    fn unshadowed(&self, light: &AreaLight) -> Option<(Ray, Vec3)> {
+    fn unshadowed(&self, light: &AreaLight, point: &LightPoint) -> Option<(Ray, Vec3)> {
         let surface = &self.surface;
-        let to_light = light.centroid() - surface.p;
+        let to_light = point.centroid - surface.p;
         let d2 = to_light.length_squared();
         let wi = to_light / d2.sqrt();
         let cos_surface = surface.ns.dot(wi);
@@ -114,9 +132,9 @@ impl Receiver {
         if cos_surface <= 0.0 || cos_light <= 0.0 || surface.ng.dot(wi) <= 0.0 {
             return None;
         }
+        // A diffuse BSDF is its constant wherever `wi` is above `ns` (`cos_surface > 0` here).
+        let f = self.lambertian.unwrap_or_else(|| self.bsdf.eval(self.wo, self.frame.to_local(wi)));
         // The segment ends on the light's shadow-target triangle, just in front of the light.
-        let target = light.shadow_target(Vec3::splat(1.0 / 3.0));
-        let f = self.bsdf.eval(self.wo, self.frame.to_local(wi));
-        Some((surface.spawn_segment(target), f * light.emission * (cos_surface * cos_light * light.area / d2)))
+        Some((surface.spawn_segment(point.target), f * light.emission * (cos_surface * cos_light * light.area / d2)))
     }
 }
