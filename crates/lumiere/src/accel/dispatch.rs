@@ -8,6 +8,7 @@
 use glam::Vec3;
 
 use super::bvh2::{BuildPreset, Bvh};
+use super::simd::lanes_of;
 use super::simd::portable::F32xN;
 use super::wide::{PacketKey, RayPacket, WideBvh};
 use super::{Bvh4, Hit, Isa, OriginBatch, Region, TraversalStats};
@@ -264,10 +265,4 @@ impl Accel {
         }
         alone
     }
-}
-
-/// The lanes whose bits are set in `mask`, in increasing order.
-#[inline(always)]
-fn lanes_of(mask: u32) -> impl Iterator<Item = usize> {
-    (0..32).filter(move |lane| mask & (1 << lane) != 0)
 }

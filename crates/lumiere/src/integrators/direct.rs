@@ -1,6 +1,7 @@
 use glam::{Vec2, Vec3};
 
 use super::{SampleContext, ShadesClosestHit, shading_frame};
+use crate::accel::simd::lanes_of;
 use crate::accel::{Hit, OriginBatch, Region};
 use crate::geometry::surface::SurfacePoint;
 use crate::lights::{AreaLight, LightSample, LightSelection, LightSet};
@@ -91,10 +92,8 @@ impl<B: Bsdf> Receiver<'_, B> {
             };
             ctx.rays += u64::from(traced.count_ones());
             let visible = traced & !world.occluded_lanes_in_batch(batch, &segments, 1.0, traced);
-            for (lane, contribution) in contributions.iter().enumerate() {
-                if visible & (1 << lane) != 0 {
-                    sum += *contribution;
-                }
+            for lane in lanes_of(visible) {
+                sum += contributions[lane];
             }
         }
         sum

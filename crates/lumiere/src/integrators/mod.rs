@@ -10,6 +10,7 @@ mod shadows;
 
 use glam::Vec3;
 
+use crate::accel::simd::lanes_of;
 use crate::accel::{Hit, OriginBatch};
 use crate::error::{Error, Result};
 use crate::math::{Frame, Ray};
@@ -118,8 +119,7 @@ pub struct CameraPacket<'a> {
 impl CameraPacket<'_> {
     /// The live lanes, in order.
     pub fn lanes(&self) -> impl Iterator<Item = usize> + use<> {
-        let live = self.live;
-        (0..PACKET).filter(move |lane| live & (1 << lane) != 0)
+        lanes_of(self.live)
     }
 }
 

@@ -2,6 +2,7 @@ use glam::Vec3;
 
 use super::{CameraPacket, Integrator, PACKET, SampleContext, shading_frame};
 use crate::accel::Hit;
+use crate::accel::simd::lanes_of;
 use crate::geometry::surface::SurfacePoint;
 use crate::lights::AreaLight;
 use crate::materials::{Bsdf, MaterialBsdf};
@@ -67,10 +68,8 @@ impl Integrator for Shadows {
             }
             ctx.rays += u64::from(traced.count_ones());
             let lit = traced & !world.occluded_packet(&segments, traced);
-            for (lane, value) in radiance.iter_mut().enumerate() {
-                if lit & (1 << lane) != 0 {
-                    *value += contributions[lane];
-                }
+            for lane in lanes_of(lit) {
+                radiance[lane] += contributions[lane];
             }
         }
         radiance

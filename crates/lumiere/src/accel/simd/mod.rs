@@ -84,6 +84,19 @@ pub trait LaneMask: Copy + Debug + BitAnd<Output = Self> + BitOr<Output = Self> 
     fn bits(self) -> u32;
 }
 
+/// The lanes whose bits are set in `mask`, in increasing order.
+#[inline(always)]
+pub fn lanes_of(mask: u32) -> impl Iterator<Item = usize> {
+    let mut rest = mask;
+    std::iter::from_fn(move || {
+        (rest != 0).then(|| {
+            let lane = rest.trailing_zeros() as usize;
+            rest &= rest - 1;
+            lane
+        })
+    })
+}
+
 /// Bits `0..width` set: the mask of all lanes, for complementing [`LaneMask::bits`].
 pub const fn all_lanes(width: usize) -> u32 {
     assert!(width != 0 && width <= 32, "a lane mask is a u32");

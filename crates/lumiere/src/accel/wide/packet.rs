@@ -17,6 +17,7 @@ use super::leaf::{self, LEAF_BIT};
 use super::node::{EMPTY_CHILD, TriangleBlock, WideNode};
 use super::traverse::Stack;
 use crate::accel::Hit;
+use crate::accel::simd::lanes_of;
 use crate::accel::slab::{BOX_EXPANSION, PRUNE_SLACK, safe_reciprocal};
 use crate::geometry::triangle::{CANCELLATION_ERROR, WatertightRay, dominant_axis, intersect_triangle};
 use crate::math::Ray;
@@ -269,8 +270,8 @@ fn test_triangle_scalar<const N: usize, const W: usize>(
 ) -> [Option<crate::geometry::triangle::TriangleHit>; N] {
     let corner = |c: usize| glam::Vec3::from_array([0, 1, 2].map(|a| block.vertices[c][a][lane_in_block]));
     let mut hits = [None; N];
-    for (lane, hit) in hits.iter_mut().enumerate().filter(|(lane, _)| lanes & (1 << lane) != 0) {
-        *hit = intersect_triangle(&packet.watertight(lane), tmax[lane], corner(0), corner(1), corner(2));
+    for lane in lanes_of(lanes) {
+        hits[lane] = intersect_triangle(&packet.watertight(lane), tmax[lane], corner(0), corner(1), corner(2));
     }
     hits
 }

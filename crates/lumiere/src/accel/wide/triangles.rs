@@ -5,7 +5,7 @@
 //! and the binary BVH therefore give identical answers, which the tests demand.
 
 use super::node::TriangleBlock;
-use crate::accel::simd::{LaneMask, Lanes, all_lanes};
+use crate::accel::simd::{LaneMask, Lanes, all_lanes, lanes_of};
 use crate::geometry::triangle::{CANCELLATION_ERROR, WatertightRay, intersect_triangle};
 use crate::math::Ray;
 
@@ -101,7 +101,7 @@ fn resolve_scalar_lanes<const W: usize>(
     lanes: u32,
     hits: &mut BlockHits<W>,
 ) {
-    for lane in (0..W).filter(|l| lanes & (1 << l) != 0) {
+    for lane in lanes_of(lanes) {
         let corner = |c: usize| glam::Vec3::from_array([0, 1, 2].map(|a| block.vertices[c][a][lane]));
         if let Some(h) = intersect_triangle(ray, tmax, corner(0), corner(1), corner(2)) {
             hits.mask |= 1 << lane;
