@@ -52,8 +52,6 @@ struct PluckerBlock {
     edges: [[[f32; 4]; 3]; 3],
     normal: [[f32; 4]; 3],
     plane_offset: [f32; 4],
-    /// Roughly the solid angle the four triangles cover, seen from the origin (for ordering only).
-    solid_angle: f32,
 }
 
 /// A convex region of space, `n . x + d >= 0` for every plane, that contains every ray of a batch.
@@ -185,12 +183,12 @@ impl OriginBatch {
         }
         L::dispatch(
             #[inline(always)]
-            || self.gather(bvh, origin, region),
+            || self.gather(bvh, region),
         );
     }
 
     #[inline(always)]
-    fn gather<const W: usize, L: Lanes<W>>(&mut self, bvh: &WideBvh<W, L>, origin: Vec3, region: &Region) {
+    fn gather<const W: usize, L: Lanes<W>>(&mut self, bvh: &WideBvh<W, L>, region: &Region) {
         // Triangles kept but not yet packed into a block of four.
         let mut pending = arrayvec_like::Pending::default();
         // Depth-first walk of the region; a wide level pushes at most `W` children (one row of the
@@ -215,8 +213,7 @@ impl OriginBatch {
                             continue;
                         }
                         if pending.len() == 4 {
-                            self.blocks.push(plucker_block(origin, &pending));
-                            pending.clear();
+                            self.push_block(&mut pending);
                         }
                         if self.blocks.len() == MAX_CANDIDATE_BLOCKS {
                             self.traverse = true;
@@ -238,9 +235,26 @@ impl OriginBatch {
             }
         }
         if !pending.is_empty() {
-            self.blocks.push(plucker_block(origin, &pending));
+            self.push_block(&mut pending);
         }
-        self.order_by_solid_angle();
+    }
+
+    /// Appends the Plücker block of the `pending` triangles (emptying it), written in place: a
+    /// block built on the stack and pushed was a `memcpy` call per block (8% of ambient occlusion
+    /// at N = 16).
+    #[inline(always)]
+    fn push_block(&mut self, pending: &mut arrayvec_like::Pending) {
+        if self.blocks.len() == self.blocks.capacity() {
+            self.blocks.reserve(MAX_CANDIDATE_BLOCKS);
+        }
+        let len = self.blocks.len();
+        // SAFETY: there is room for one more block (reserved above); `write_plucker_block` writes
+        // every field of the slot before the length covers it.
+        unsafe {
+            write_plucker_block(self.blocks.as_mut_ptr().add(len), self.origin, pending.padded());
+            self.blocks.set_len(len + 1);
+        }
+        pending.clear();
     }
 
     /// The origin the batch was prepared for.
@@ -256,12 +270,6 @@ impl OriginBatch {
     /// Candidate blocks gathered, and whether rays fall back to traversal (for tests and tuning).
     pub fn candidate_blocks(&self) -> Option<usize> {
         (!self.traverse).then_some(self.blocks.len())
-    }
-
-    /// Puts the blocks that cover the most solid angle first, so that an any-hit query over many
-    /// random directions (ambient occlusion in a closed room) usually stops at the first block.
-    fn order_by_solid_angle(&mut self) {
-        self.blocks.sort_by(|a, b| b.solid_angle.total_cmp(&a.solid_angle));
     }
 
     /// True if the ray (which must leave from the prepared origin, inside the region) is blocked
@@ -326,7 +334,8 @@ impl OriginBatch {
                     blocked[ray] |= crosses & ahead & within;
                 }
             }
-            // Blocks come largest solid angle first: most rays of a closed room stop early.
+            // In a closed room every ray is often blocked after the first blocks. (Sorting the
+            // blocks by solid angle first, to stop sooner, cost more than it saved at every N.)
             if blocked.iter().all(|&b| b) {
                 break;
             }
@@ -335,14 +344,14 @@ impl OriginBatch {
     }
 }
 
-/// Edge vectors and planes of up to four triangles (SoA, `vertices[corner][axis][lane]`) relative
-/// to `origin`, computed four lanes at a time; unused lanes repeat the last triangle (a duplicate
-/// never changes an any-hit answer).
-/// Inlined into the gathering walk: out of line, its 212-byte result was copied by a `memcpy`
-/// call into the block list (with the call, a sixth of an ambient-occlusion render at N = 16).
+/// Writes to `block` the edge vectors and planes of four triangles (SoA, `vertices[corner][axis][lane]`;
+/// lanes past the gathered triangles repeat the last one: a duplicate never changes an any-hit
+/// answer) relative to `origin`, computed four lanes at a time.
+///
+/// # Safety
+/// `block` must be valid for writes.
 #[inline(always)]
-fn plucker_block(origin: Vec3, pending: &arrayvec_like::Pending) -> PluckerBlock {
-    let vertices = pending.soa();
+unsafe fn write_plucker_block(block: *mut PluckerBlock, origin: Vec3, vertices: &[[[f32; 4]; 3]; 3]) {
     let o = origin.to_array();
     let rel = |c: usize| -> [F32x4; 3] { [0, 1, 2].map(|a| F32x4::load(&vertices[c][a]) - F32x4::splat(o[a])) };
     let (a, b, c) = (rel(0), rel(1), rel(2));
@@ -353,28 +362,18 @@ fn plucker_block(origin: Vec3, pending: &arrayvec_like::Pending) -> PluckerBlock
     let dot = |u: &[F32x4; 3], v: &[F32x4; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
     let edges = [cross(&b, &c), cross(&c, &a), cross(&a, &b)];
     let normal = cross(&sub(&b, &a), &sub(&c, &a));
-    let to_array = |v: [F32x4; 3]| v.map(F32x4::to_array);
-    let mut block = PluckerBlock {
-        edges: edges.map(to_array),
-        normal: to_array(normal),
-        plane_offset: dot(&a, &normal).to_array(),
-        solid_angle: 0.0,
-    };
-    // Projected area over squared distance, |n . (c - o)| / |c - o|^3 with |n| twice the area, of
-    // the real lanes: for ordering only.
-    // A loop over the four lanes (vectorised), each with `Vec3::length` and `Vec3::dot`'s operations.
-    let centroid = [0, 1, 2].map(|k| ((a[k] + b[k] + c[k]) * F32x4::splat(1.0 / 3.0)).to_array());
-    let mut projected = [0.0f32; 4];
-    for (lane, value) in projected.iter_mut().enumerate() {
-        let [cx, cy, cz] = centroid.map(|axis| axis[lane]);
-        let [nx, ny, nz] = block.normal.map(|axis| axis[lane]);
-        let distance = (cx * cx + cy * cy + cz * cz).sqrt().max(f32::MIN_POSITIVE);
-        *value = (nx * cx + ny * cy + nz * cz).abs() / (distance * distance * distance);
+    // SAFETY: the caller's; each field is written through the raw pointer, not read.
+    unsafe {
+        for (k, edge) in edges.iter().enumerate() {
+            for (axis, lanes) in edge.iter().enumerate() {
+                (*block).edges[k][axis] = lanes.to_array();
+            }
+        }
+        for (axis, lanes) in normal.iter().enumerate() {
+            (*block).normal[axis] = lanes.to_array();
+        }
+        (*block).plane_offset = dot(&a, &normal).to_array();
     }
-    for &value in &projected[..pending.len()] {
-        block.solid_angle += if value.is_finite() { value } else { f32::MAX };
-    }
-    block
 }
 
 /// Up to four gathered triangles in SoA layout, so that packing them allocates nothing.
@@ -406,17 +405,16 @@ mod arrayvec_like {
         pub fn clear(&mut self) {
             self.len = 0;
         }
-        /// The triangles, with the unused lanes repeating the last one.
-        pub fn soa(&self) -> [[[f32; 4]; 3]; 3] {
-            let mut v = self.vertices;
+        /// The triangles, the unused lanes made to repeat the last one.
+        pub fn padded(&mut self) -> &[[[f32; 4]; 3]; 3] {
             for lane in self.len..4 {
-                for corner in v.iter_mut() {
+                for corner in self.vertices.iter_mut() {
                     for axis in corner.iter_mut() {
                         axis[lane] = axis[self.len - 1];
                     }
                 }
             }
-            v
+            &self.vertices
         }
     }
 }
