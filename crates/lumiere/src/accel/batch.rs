@@ -190,7 +190,7 @@ impl OriginBatch {
     #[inline(always)]
     fn gather<const W: usize, L: Lanes<W>>(&mut self, bvh: &WideBvh<W, L>, region: &Region) {
         // Triangles kept but not yet packed into a block of four.
-        let mut pending = arrayvec_like::Pending::default();
+        let mut pending = pending::Pending::new(&bvh.blocks[0]);
         // Depth-first walk of the region; a wide level pushes at most `W` children (one row of the
         // stack per level, as in `wide/traverse.rs`). Left uninitialised, as there: zeroing its
         // 2.3 KB for every origin was a fifth of a soft-shadow render's instructions (callgrind).
@@ -243,7 +243,7 @@ impl OriginBatch {
     /// block built on the stack and pushed was a `memcpy` call per block (8% of ambient occlusion
     /// at N = 16).
     #[inline(always)]
-    fn push_block(&mut self, pending: &mut arrayvec_like::Pending) {
+    fn push_block<const W: usize>(&mut self, pending: &mut pending::Pending<W>) {
         if self.blocks.len() == self.blocks.capacity() {
             self.blocks.reserve(MAX_CANDIDATE_BLOCKS);
         }
@@ -251,7 +251,7 @@ impl OriginBatch {
         // SAFETY: there is room for one more block (reserved above); `write_plucker_block` writes
         // every field of the slot before the length covers it.
         unsafe {
-            write_plucker_block(self.blocks.as_mut_ptr().add(len), self.origin, pending.padded());
+            write_plucker_block(self.blocks.as_mut_ptr().add(len), self.origin, pending.corners());
             self.blocks.set_len(len + 1);
         }
         pending.clear();
@@ -344,16 +344,16 @@ impl OriginBatch {
     }
 }
 
-/// Writes to `block` the edge vectors and planes of four triangles (SoA, `vertices[corner][axis][lane]`;
+/// Writes to `block` the edge vectors and planes of four triangles (`corners[corner][axis]`, a lane each;
 /// lanes past the gathered triangles repeat the last one: a duplicate never changes an any-hit
 /// answer) relative to `origin`, computed four lanes at a time.
 ///
 /// # Safety
 /// `block` must be valid for writes.
 #[inline(always)]
-unsafe fn write_plucker_block(block: *mut PluckerBlock, origin: Vec3, vertices: &[[[f32; 4]; 3]; 3]) {
+unsafe fn write_plucker_block(block: *mut PluckerBlock, origin: Vec3, corners: [[F32x4; 3]; 3]) {
     let o = origin.to_array();
-    let rel = |c: usize| -> [F32x4; 3] { [0, 1, 2].map(|a| F32x4::load(&vertices[c][a]) - F32x4::splat(o[a])) };
+    let rel = |c: usize| -> [F32x4; 3] { [0, 1, 2].map(|a| corners[c][a] - F32x4::splat(o[a])) };
     let (a, b, c) = (rel(0), rel(1), rel(2));
     let cross = |u: &[F32x4; 3], v: &[F32x4; 3]| {
         [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
@@ -376,24 +376,27 @@ unsafe fn write_plucker_block(block: *mut PluckerBlock, origin: Vec3, vertices: 
     }
 }
 
-/// Up to four gathered triangles in SoA layout, so that packing them allocates nothing.
-mod arrayvec_like {
+/// Up to four gathered triangles, as the blocks and lanes they are found in. Their corners are
+/// read into vectors only when the four are packed: written lane by lane into an SoA buffer and
+/// then loaded as vectors, each load waited for four stores it could not be forwarded from (an
+/// eighth of ambient occlusion at N = 16).
+mod pending {
+    use crate::accel::simd::{F32x4, Lanes};
     use crate::accel::wide::TriangleBlock;
 
-    #[derive(Default)]
-    pub struct Pending {
-        vertices: [[[f32; 4]; 3]; 3],
+    pub struct Pending<'a, const W: usize> {
+        triangles: [(&'a TriangleBlock<W>, usize); 4],
         len: usize,
     }
 
-    impl Pending {
+    impl<'a, const W: usize> Pending<'a, W> {
+        /// Empty; `first` only fills the unused slots.
+        pub fn new(first: &'a TriangleBlock<W>) -> Self {
+            Pending { triangles: [(first, 0); 4], len: 0 }
+        }
         /// Appends triangle `lane` of `block`.
-        pub fn push<const W: usize>(&mut self, block: &TriangleBlock<W>, lane: usize) {
-            for corner in 0..3 {
-                for axis in 0..3 {
-                    self.vertices[corner][axis][self.len] = block.vertices[corner][axis][lane];
-                }
-            }
+        pub fn push(&mut self, block: &'a TriangleBlock<W>, lane: usize) {
+            self.triangles[self.len] = (block, lane);
             self.len += 1;
         }
         pub fn len(&self) -> usize {
@@ -405,16 +408,18 @@ mod arrayvec_like {
         pub fn clear(&mut self) {
             self.len = 0;
         }
-        /// The triangles, the unused lanes made to repeat the last one.
-        pub fn padded(&mut self) -> &[[[f32; 4]; 3]; 3] {
-            for lane in self.len..4 {
-                for corner in self.vertices.iter_mut() {
-                    for axis in corner.iter_mut() {
-                        axis[lane] = axis[self.len - 1];
-                    }
-                }
-            }
-            &self.vertices
+        /// The corners of the triangles, `[corner][axis]` with one lane per triangle; the unused
+        /// lanes repeat the last triangle.
+        #[inline(always)]
+        pub fn corners(&self) -> [[F32x4; 3]; 3] {
+            let slot = |lane: usize| self.triangles[lane.min(self.len - 1)];
+            let [t0, t1, t2, t3] = [0, 1, 2, 3].map(slot);
+            std::array::from_fn(|corner| {
+                std::array::from_fn(|axis| {
+                    let value = |(block, lane): (&TriangleBlock<W>, usize)| block.vertices[corner][axis][lane];
+                    F32x4::load(&[value(t0), value(t1), value(t2), value(t3)])
+                })
+            })
         }
     }
 }
