@@ -32,11 +32,12 @@ use crate::math::Ray;
 const MAX_CANDIDATE_BLOCKS: usize = 24;
 
 /// Fewer rays than this per origin do not pay for gathering their candidates: measured on the
-/// Cornell box with the ray-major test (`--mode direct` and `--mode ao` at N = 4 to 256, one
-/// thread), a shaft towards a light triangle pays from 8 rays (4: 4% slower than traversal), a
-/// hemisphere, which keeps more triangles, from 16 (28% faster there; 8: 15% slower).
-const MIN_SHAFT_RAYS: u32 = 8;
-const MIN_HEMISPHERE_RAYS: u32 = 16;
+/// Cornell box (`--mode direct` and `--mode ao --spp 4` at N = 2 to 8, two threads, gathering
+/// against traversal alternately), a shaft towards a light triangle pays from 4 rays (27% faster
+/// there; 2: within noise), a hemisphere, which keeps more triangles, from 8 (28% faster; 4: 10%
+/// slower).
+const MIN_SHAFT_RAYS: u32 = 4;
+const MIN_HEMISPHERE_RAYS: u32 = 8;
 
 /// Scenes with more triangles than this never batch a hemisphere: an unbounded half-space above a
 /// surface holds a sizeable part of any such scene, far more than `MAX_CANDIDATE_BLOCKS` blocks, and
