@@ -86,9 +86,9 @@ impl Sampler {
         independent_bits_in(self.independent_key(pixel, dimension), index)
     }
 
-    /// The key of the independent numbers of one (pixel, dimension): a random 64-bit value, so
-    /// that two keys never share the indices' small differences (their sets of inputs to
-    /// [`independent_bits_in`] overlap only if the keys agree in all but the low bits).
+    /// The key of the independent numbers of one (pixel, dimension): a random 64-bit value. Two
+    /// (pixel, dimension) pairs feed the finaliser a common input only if their keys agree in the
+    /// top 32 bits, which the index never reaches (a chance of 2⁻³² per pair).
     #[inline]
     fn independent_key(&self, pixel: u32, dimension: u32) -> u64 {
         mix64(self.key ^ (u64::from(pixel) << 32 | u64::from(dimension)))

@@ -190,7 +190,8 @@ impl OriginBatch {
 
     #[inline(always)]
     fn gather<const W: usize, L: Lanes<W>>(&mut self, bvh: &WideBvh<W, L>, region: &Region) {
-        // Triangles kept but not yet packed into a block of four.
+        // Triangles kept but not yet packed into a block of four. (`prepare` gathers only in a
+        // BVH with triangles, so it has a first block.)
         let mut pending = pending::Pending::new(&bvh.blocks[0]);
         // Depth-first walk of the region; a wide level pushes at most `W` children (one row of the
         // stack per level, as in `wide/traverse.rs`). Left uninitialised, as there: zeroing its
@@ -345,9 +346,9 @@ impl OriginBatch {
     }
 }
 
-/// Writes to `block` the edge vectors and planes of four triangles (`corners[corner][axis]`, a lane each;
-/// lanes past the gathered triangles repeat the last one: a duplicate never changes an any-hit
-/// answer) relative to `origin`, computed four lanes at a time.
+/// Writes to `block` the edge vectors and planes of four triangles (`corners[corner][axis]`, a
+/// lane each; lanes past the gathered triangles repeat the last one: a duplicate never changes an
+/// any-hit answer) relative to `origin`, computed four lanes at a time.
 ///
 /// # Safety
 /// `block` must be valid for writes.
