@@ -119,17 +119,27 @@ impl<const N: usize> RayPacket<N> {
     /// test of `traverse.rs`, one lane per ray), as a mask, and the nearest entry among them.
     #[inline(always)]
     fn enter<const W: usize>(&self, node: &WideNode<W>, child: usize, limit: &[f32; N]) -> (u32, f32) {
-        let mut near = [0.0f32; N];
-        let mut far = *limit;
-        for axis in 0..3 {
-            let near_plane = node.bounds[self.near_rows[axis]][child];
-            let far_plane = node.bounds[(self.near_rows[axis] + 3) % 6][child];
-            let (origin, inv_dir) = (&self.origin[axis], &self.inv_dir[axis]);
-            for lane in 0..N {
-                near[lane] = max_ps(near[lane], (near_plane - origin[lane]) * inv_dir[lane]);
-                far[lane] = min_ps(far[lane], (far_plane - origin[lane]) * inv_dir[lane] * BOX_EXPANSION);
-            }
-        }
+        let bounds = std::array::from_fn(|row| node.bounds[row][child]);
+        self.enter_box(&bounds, limit)
+    }
+
+    /// Whether any lane enters the box of triangle `lane_in_block` of `block` before `limit` (the
+    /// slab test is conservative: a ray that hits a triangle enters its box). See [`BoxFirst`].
+    #[inline(always)]
+    fn may_hit<const W: usize>(&self, block: &TriangleBlock<W>, lane_in_block: usize, limit: &[f32; N]) -> bool {
+        let v = |corner: usize, axis: usize| block.vertices[corner][axis][lane_in_block];
+        let low = |axis: usize| v(0, axis).min(v(1, axis)).min(v(2, axis));
+        let high = |axis: usize| v(0, axis).max(v(1, axis)).max(v(2, axis));
+        let bounds = [low(0), low(1), low(2), high(0), high(1), high(2)];
+        let (near, far) = self.slabs(&bounds, limit);
+        // Any lane, without building the lane mask.
+        near.iter().zip(&far).fold(false, |any, (n, f)| any | (n <= f))
+    }
+
+    /// [`RayPacket::enter`] for a box given as its rows (min x, y, z, then max x, y, z).
+    #[inline(always)]
+    fn enter_box(&self, bounds: &[f32; 6], limit: &[f32; N]) -> (u32, f32) {
+        let (near, far) = self.slabs(bounds, limit);
         let mut mask = 0u32;
         let mut nearest = f32::INFINITY;
         for lane in 0..N {
@@ -138,6 +148,23 @@ impl<const N: usize> RayPacket<N> {
             nearest = if enters && near[lane] < nearest { near[lane] } else { nearest };
         }
         (mask, nearest)
+    }
+
+    /// Each lane's entry and exit distances of a box given as its rows, the exit clipped to `limit`.
+    #[inline(always)]
+    fn slabs(&self, bounds: &[f32; 6], limit: &[f32; N]) -> ([f32; N], [f32; N]) {
+        let mut near = [0.0f32; N];
+        let mut far = *limit;
+        for axis in 0..3 {
+            let near_plane = bounds[self.near_rows[axis]];
+            let far_plane = bounds[(self.near_rows[axis] + 3) % 6];
+            let (origin, inv_dir) = (&self.origin[axis], &self.inv_dir[axis]);
+            for lane in 0..N {
+                near[lane] = max_ps(near[lane], (near_plane - origin[lane]) * inv_dir[lane]);
+                far[lane] = min_ps(far[lane], (far_plane - origin[lane]) * inv_dir[lane] * BOX_EXPANSION);
+            }
+        }
+        (near, far)
     }
 }
 
@@ -276,6 +303,51 @@ fn test_triangle_scalar<const N: usize, const W: usize>(
     hits
 }
 
+/// Whether to test each triangle's box before the triangle itself. A packet tests a leaf's
+/// triangles one by one against all its rays, and one that enters a leaf often misses most of
+/// them; a box test (conservative: a ray that hits a triangle enters its box) costs about two
+/// thirds of a triangle test, so it pays where it rules out more than that: 88% of the boxes of
+/// the Cornell box's camera rays (hits and hard shadows 17% faster, the staircase's camera rays
+/// too), but 57% on the 1.1M-triangle bunny (8-14% slower when always on, 3% as decided here).
+/// Decided per thread from the packets it traced: on while at least two
+/// thirds were ruled out, with every 16th packet testing boxes anyway to keep the count current
+/// (a thread moves between regions of a scene). It only skips triangles no lane can hit, so the
+/// hits never depend on it.
+#[derive(Clone, Copy, Default)]
+struct BoxFirst {
+    packets: u32,
+    tested: u32,
+    ruled_out: u32,
+}
+
+thread_local! {
+    static BOX_FIRST: std::cell::Cell<BoxFirst> = const { std::cell::Cell::new(BoxFirst { packets: 0, tested: 0, ruled_out: 0 }) };
+}
+
+impl BoxFirst {
+    /// Box tests counted before the first decision, and the most kept (older ones are halved).
+    const TRIAL: u32 = 64;
+    const WINDOW: u32 = 4096;
+
+    /// Whether the next packet tests boxes.
+    fn for_next_packet() -> bool {
+        let stats = BOX_FIRST.get();
+        stats.tested < Self::TRIAL || 3 * stats.ruled_out >= 2 * stats.tested || stats.packets.is_multiple_of(16)
+    }
+
+    /// Adds a packet's counts.
+    fn record(tested: u32, ruled_out: u32) {
+        let mut stats = BOX_FIRST.get();
+        stats.packets = stats.packets.wrapping_add(1);
+        stats.tested += tested;
+        stats.ruled_out += ruled_out;
+        if stats.tested > Self::WINDOW {
+            (stats.tested, stats.ruled_out) = (stats.tested / 2, stats.ruled_out / 2);
+        }
+        BOX_FIRST.set(stats);
+    }
+}
+
 /// Whether triangle `lane` of a block is real, not the repeat of its predecessor that pads a leaf.
 #[inline(always)]
 fn is_padding<const W: usize>(block: &TriangleBlock<W>, lane: usize) -> bool {
@@ -295,6 +367,8 @@ impl<const W: usize, L> WideBvh<W, L> {
         stack.push((0, 0.0));
         let mut farthest_limit = tmax.iter().fold(f32::NEG_INFINITY, |a, &b| max_ps(a, b));
         let mut out = [[0.0f32; N]; 3];
+        let use_boxes = BoxFirst::for_next_packet();
+        let (mut boxes_tested, mut boxes_ruled_out) = (0u32, 0u32);
         while let Some((reference, nearest)) = stack.pop() {
             // No lane can find anything closer in there (the single-ray pruning, for the packet).
             if nearest > farthest_limit * PRUNE_SLACK {
@@ -305,8 +379,16 @@ impl<const W: usize, L> WideBvh<W, L> {
                 push_children(&mut stack, packet, &self.nodes[reference as usize], &limit);
                 continue;
             }
+            let limit = tmax.map(|t| t * PRUNE_SLACK);
             for block in &self.blocks[leaf::blocks::<W>(reference)] {
                 for lane_in_block in (0..W).filter(|&l| !is_padding(block, l)) {
+                    if use_boxes {
+                        boxes_tested += 1;
+                        if !packet.may_hit(block, lane_in_block, &limit) {
+                            boxes_ruled_out += 1;
+                            continue;
+                        }
+                    }
                     let id = block.ids[lane_in_block];
                     let (mut hit, scalar) = test_triangle(packet, block, lane_in_block, &tmax, &mut out);
                     if scalar != 0 {
@@ -331,6 +413,7 @@ impl<const W: usize, L> WideBvh<W, L> {
                 }
             }
         }
+        BoxFirst::record(boxes_tested, boxes_ruled_out);
         std::array::from_fn(|lane| {
             (closest.triangle[lane] != u32::MAX).then(|| Hit {
                 t: closest.t[lane],
@@ -350,6 +433,8 @@ impl<const W: usize, L> WideBvh<W, L> {
         let mut stack = Stack::<W>::new();
         stack.push((0, 0.0));
         let mut out = [[0.0f32; N]; 3];
+        let use_boxes = BoxFirst::for_next_packet();
+        let (mut boxes_tested, mut boxes_ruled_out) = (0u32, 0u32);
         while let Some((reference, _)) = stack.pop() {
             if reference & LEAF_BIT == 0 {
                 push_children(&mut stack, packet, &self.nodes[reference as usize], &limit);
@@ -357,6 +442,13 @@ impl<const W: usize, L> WideBvh<W, L> {
             }
             for block in &self.blocks[leaf::blocks::<W>(reference)] {
                 for lane_in_block in (0..W).filter(|&l| !is_padding(block, l)) {
+                    if use_boxes {
+                        boxes_tested += 1;
+                        if !packet.may_hit(block, lane_in_block, &limit) {
+                            boxes_ruled_out += 1;
+                            continue;
+                        }
+                    }
                     let (hit, scalar) = test_triangle(packet, block, lane_in_block, &packet.tmax, &mut out);
                     blocked |= hit;
                     let undecided = scalar & !blocked;
@@ -367,11 +459,13 @@ impl<const W: usize, L> WideBvh<W, L> {
                         }
                     }
                     if blocked & wanted == wanted {
+                        BoxFirst::record(boxes_tested, boxes_ruled_out);
                         return blocked;
                     }
                 }
             }
         }
+        BoxFirst::record(boxes_tested, boxes_ruled_out);
         blocked
     }
 }
