@@ -144,8 +144,11 @@ fn interruption_writes_the_completed_samples_and_exits_3() {
 #[test]
 fn killed_and_resumed_renders_give_identical_bytes() {
     let dir = TempDir::new("kill");
-    // About 1.5 s of work, so that every kill point lands mid-render.
-    let args = ["render", "--mode", "direct", "--samples", "8", "--spp", "96", "--size", "96x72", "--sampler", "sobol"];
+    // About 1.5 s of work alone (1.8 s with its checkpoints, on the 2-core machine of 2026-12-02),
+    // so that most kill points land mid-render; at 96x72 faster batches had brought it to 0.2 s,
+    // and too few kills landed.
+    let args =
+        ["render", "--mode", "direct", "--samples", "8", "--spp", "96", "--size", "256x192", "--sampler", "sobol"];
     let reference = dir.arg("reference.pfm");
     let run = lumiere(&[&args[..], &["-o", &reference]].concat());
     assert!(run.status.success(), "{}", stderr(&run));
