@@ -20,8 +20,8 @@
 //! index) and then the dimension, so `direct` and `ao` (the lab's modes draw from it; `path`
 //! defaults to Sobol) draw other, equally distributed numbers. Over 64 seeds at 128x96, 16 spp,
 //! the image means of `direct --samples 4` and `ao --samples 3 --ao-distance 0.5` moved by
-//! -0.008% (-0.6 standard errors) and +0.012% (+1.2); over 16 seeds `ao --samples 4`,
-//! `direct --samples 16` and `ao --samples 40` by -0.7, -0.9 and -1.6 standard errors.
+//! -0.008% (-0.6 standard errors) and +0.012% (+1.2); over 16 seeds at 128x96, `ao --samples 4`
+//! (16 spp), `direct --samples 16` (4 spp) and `ao --samples 40` (2 spp) by -0.7, -0.9 and -1.6.
 
 use std::process::Command;
 use std::sync::atomic::{AtomicUsize, Ordering};

@@ -305,15 +305,14 @@ fn test_triangle_scalar<const N: usize, const W: usize>(
 
 /// Whether to test each triangle's box before the triangle itself. A packet tests a leaf's
 /// triangles one by one against all its rays, and one that enters a leaf often misses most of
-/// them; a box test (conservative: a ray that hits a triangle enters its box) costs about two
-/// thirds of a triangle test, so it pays where it rules out more than that: 88% of the boxes of
-/// the Cornell box's camera rays (hits and hard shadows 17% faster, the staircase's camera rays
-/// too), but 57% on the 1.1M-triangle bunny (8-14% slower when always on, 3% as decided here).
-/// Decided per thread from the packets it traced: on while at least two
-/// thirds were ruled out, with every 16th packet testing boxes anyway to keep the count current
-/// (a thread moves between regions of a scene). It only skips triangles no lane can hit, so the
-/// hits never depend on it.
-#[derive(Clone, Copy, Default)]
+/// them. A box test (conservative: a ray that hits a triangle enters its box) pays where it rules
+/// out most triangles: 88% of the boxes of the Cornell box's camera packets do (hits and hard
+/// shadows 17% faster, the staircase's camera rays too), 57% on the 1.1M-triangle bunny, where
+/// testing every box was 8-14% slower (3% as decided here). Decided per thread from the packets
+/// it traced: on while at least two thirds of the boxes were ruled out (between the two), with
+/// every 16th packet testing boxes anyway to keep the count current (a thread moves between
+/// regions of a scene). It only skips triangles no lane can hit, so the hits never depend on it.
+#[derive(Clone, Copy)]
 struct BoxFirst {
     packets: u32,
     tested: u32,
