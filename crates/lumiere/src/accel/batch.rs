@@ -59,15 +59,18 @@ struct PluckerBlock {
 /// A convex region of space, `n . x + d >= 0` for every plane, that contains every ray of a batch.
 #[derive(Clone, Copy, Debug)]
 pub struct Region {
-    planes: [Vec4; 4],
+    planes: [Vec4; MAX_PLANES],
     /// A box or triangle is kept only if it reaches above `keep_above[i]` on plane `i`. Planes
     /// through the origin of the rays get a small negative margin (the few-ulp offsets of ray ends
     /// and the rounding of the plane equations); planes the rays cannot reach (the light's, which
     /// the segments end in front of; the surface's, which the rays leave) get 0, so that what lies
     /// on them (the light itself, a coplanar ceiling, the floor under a point) is left out.
-    keep_above: [f32; 4],
+    keep_above: [f32; MAX_PLANES],
     count: usize,
 }
+
+/// A shaft towards a quad: four sides and the quad's plane.
+const MAX_PLANES: usize = 5;
 
 impl Region {
     /// The tetrahedron spanned by `origin` and the triangle `corners` (the shaft of all segments
@@ -81,25 +84,41 @@ impl Region {
             [corners[0], corners[1], corners[2]],
         ];
         let size = corners.iter().map(|c| (*c - origin).length()).fold(0.0f32, f32::max);
-        let mut planes = [Vec4::ZERO; 4];
+        let mut planes = [Vec4::ZERO; MAX_PLANES];
         for (plane, [a, b, c]) in planes.iter_mut().zip(faces) {
-            let n = (b - a).cross(c - a).try_normalize()?;
-            let n = if n.dot(centroid - a) < 0.0 { -n } else { n };
-            *plane = n.extend(-n.dot(a));
+            *plane = plane_facing(a, b, c, centroid)?;
         }
         let margin = -tolerance(origin, size);
         // The segments end on the triangle `corners` (the light's shadow targets): nothing on or
         // beyond its plane can block them.
-        Some(Region { planes, keep_above: [margin, margin, margin, 0.0], count: 4 })
+        Some(Region { planes, keep_above: [margin, margin, margin, 0.0, 0.0], count: 4 })
+    }
+
+    /// The pyramid spanned by `origin` and the convex quad `corners` (in order around it), cut by
+    /// `plane` (`n . x + w`, positive at the origin), on or behind which every segment from the
+    /// origin into the quad ends; `None` if the origin is not in front of it.
+    pub fn shaft_to_quad(origin: Vec3, corners: [Vec3; 4], plane: Vec4) -> Option<Region> {
+        // In front of the plane (a NaN distance is not).
+        if plane.truncate().dot(origin) + plane.w <= 0.0 || plane.is_nan() || origin.is_nan() {
+            return None;
+        }
+        let centroid = (origin + corners[0] + corners[1] + corners[2] + corners[3]) * 0.2;
+        let size = corners.iter().map(|c| (*c - origin).length()).fold(0.0f32, f32::max);
+        let mut planes = [plane; MAX_PLANES];
+        for (k, side) in planes.iter_mut().take(4).enumerate() {
+            *side = plane_facing(origin, corners[k], corners[(k + 1) % 4], centroid)?;
+        }
+        let margin = -tolerance(origin, size);
+        Some(Region { planes, keep_above: [margin, margin, margin, margin, 0.0], count: 5 })
     }
 
     /// The half-space above the plane through `origin` with normal `normal`: rays leaving `origin`
     /// on that side never reach anything on or below the plane.
     pub fn hemisphere(origin: Vec3, normal: Vec3) -> Region {
         let n = normal.normalize();
-        let mut planes = [Vec4::ZERO; 4];
+        let mut planes = [Vec4::ZERO; MAX_PLANES];
         planes[0] = n.extend(-n.dot(origin));
-        Region { planes, keep_above: [0.0; 4], count: 1 }
+        Region { planes, keep_above: [0.0; MAX_PLANES], count: 1 }
     }
 
     /// Whether the region is a whole half-space (a hemisphere of directions), rather than a shaft.
@@ -135,6 +154,13 @@ impl Region {
         }
         inside
     }
+}
+
+/// The plane through `a`, `b`, `c`, its unit normal turned towards `inside`; `None` if degenerate.
+fn plane_facing(a: Vec3, b: Vec3, c: Vec3, inside: Vec3) -> Option<Vec4> {
+    let n = (b - a).cross(c - a).try_normalize()?;
+    let n = if n.dot(inside - a) < 0.0 { -n } else { n };
+    Some(n.extend(-n.dot(a)))
 }
 
 /// Signed distances (times the normal's length) of `W` points, SoA, above `plane`. A function

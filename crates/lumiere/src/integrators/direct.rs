@@ -220,16 +220,28 @@ impl ShadesClosestHit for Direct {
         match self.light_sampling {
             LightSampling::PerLight => {
                 // The N shadow rays towards one light triangle share their origin and stay in the shaft
-                // from it to the triangle: trace them as a batch.
+                // from it to the triangle: trace them as a batch. The two triangles of a quad light
+                // share one, the shaft to the quad (a fifth of a soft-shadow render was spent
+                // preparing the second).
                 let mut batch = std::mem::take(&mut ctx.batch);
+                let mut batch_quad = None;
                 for (index, light) in lights.lights().iter().enumerate() {
                     // Taken for every light, lit or not, so that each light keeps its dimension.
                     let points = ctx.stream.next_points(n);
                     if !faces_each_other(&surface, light) {
                         continue;
                     }
-                    let Some(shaft) = Region::shaft(origin, light.shadow_targets) else { continue };
-                    world.prepare_batch(&mut batch, origin, &shaft, n);
+                    let quad = lights.quad_of(index as u32);
+                    if quad.is_none() || quad.map(|(q, _)| q) != batch_quad {
+                        let quad_shaft = quad
+                            .and_then(|(q, quad)| Some((q, Region::shaft_to_quad(origin, quad.corners, quad.plane)?)));
+                        batch_quad = quad_shaft.map(|(q, _)| q);
+                        let shaft = quad_shaft.map(|(_, shaft)| shaft);
+                        let Some(shaft) = shaft.or_else(|| Region::shaft(origin, light.shadow_targets)) else {
+                            continue;
+                        };
+                        world.prepare_batch(&mut batch, origin, &shaft, n);
+                    }
                     let light = index as u32;
                     sum = world.simd(
                         #[inline(always)]

@@ -6,10 +6,12 @@
 //! the area measure happens here and nowhere else.
 
 mod area;
+mod quad;
 
 use glam::{Vec2, Vec3};
 
 pub use area::AreaLight;
+pub use quad::QuadLight;
 
 use crate::sampling::distrib::{AliasTable, ONE_MINUS_EPSILON};
 use crate::sampling::warp::sample_uniform_triangle;
@@ -54,6 +56,10 @@ pub struct LightSet {
     light_of_triangle: Vec<u32>,
     /// Power-proportional choice; `None` when there are no lights (or none has power).
     power: Option<AliasTable>,
+    /// Pairs of light triangles forming convex quads, and each light's quad (index into `quads`)
+    /// or `NOT_A_LIGHT`.
+    quads: Vec<QuadLight>,
+    quad_of_light: Vec<u32>,
 }
 
 impl LightSet {
@@ -65,7 +71,21 @@ impl LightSet {
             light_of_triangle[light.triangle as usize] = index as u32;
         }
         let weights: Vec<f32> = lights.iter().map(|l| l.power().element_sum()).collect();
-        LightSet { lights, light_of_triangle, power: AliasTable::new(&weights) }
+        let quads = quad::pair_lights(&lights);
+        let mut quad_of_light = vec![NOT_A_LIGHT; lights.len()];
+        for (index, quad) in quads.iter().enumerate() {
+            for light in quad.lights {
+                quad_of_light[light as usize] = index as u32;
+            }
+        }
+        LightSet { lights, light_of_triangle, power: AliasTable::new(&weights), quads, quad_of_light }
+    }
+
+    /// The convex quad light `light` forms with another light triangle, and its index, if any.
+    #[inline]
+    pub fn quad_of(&self, light: u32) -> Option<(u32, &QuadLight)> {
+        let index = *self.quad_of_light.get(light as usize)?;
+        (index != NOT_A_LIGHT).then(|| (index, &self.quads[index as usize]))
     }
 
     pub fn lights(&self) -> &[AreaLight] {

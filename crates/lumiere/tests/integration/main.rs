@@ -12,6 +12,7 @@ mod image_io;
 mod module_graph;
 mod obj_loading;
 mod path;
+mod quad_lights;
 mod range;
 mod sampling;
 mod seams;
