@@ -91,7 +91,7 @@ const CASES: [Case; 11] = [
         ("path", &["--mode", "path", "--spp", "2", "--max-depth", "5"], 0x80c5df54f8762710, 0x4e36eaaea82bfa93),
         // Enough rays per origin for shared-origin batches (recorded before the ray-major batch
         // kernels, when fewer than 8 rays per shaft or 16 per hemisphere were traversed alone; now
-        // 4 and 8, and `direct` above is batched too, with the same bytes).
+        // 2 and 4, so `direct` and `ao` above are batched too, with the same bytes).
         ("ao-batch", &["--mode", "ao", "--samples", "40"], 0x95b2635aba1830d1, 0xfa0c7269fc34b4df),
         ("ao-batch-near", &["--mode", "ao", "--samples", "33", "--spp", "2", "--ao-distance", "0.3"], 0x140520f276826a14, 0xc7c8652cc1a07a34),
         ("direct-batch", &["--mode", "direct", "--samples", "16"], 0x0fbe4c3e10b18bbe, 0x6d973776a2f02a12),

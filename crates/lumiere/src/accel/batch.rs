@@ -32,12 +32,12 @@ use crate::math::Ray;
 const MAX_CANDIDATE_BLOCKS: usize = 24;
 
 /// Fewer rays than this per origin do not pay for gathering their candidates: measured on the
-/// Cornell box (`--mode direct` and `--mode ao --spp 4` at N = 2 to 8, two threads, gathering
-/// against traversal alternately), a shaft towards a light triangle pays from 4 rays (27% faster
-/// there; 2: within noise), a hemisphere, which keeps more triangles, from 8 (28% faster; 4: 10%
-/// slower).
-const MIN_SHAFT_RAYS: u32 = 4;
-const MIN_HEMISPHERE_RAYS: u32 = 8;
+/// Cornell box (`--mode direct` and `--mode ao` at N = 1 to 6, two threads, gathering against
+/// traversal alternately, since quad shafts and whole groups made gathering cheaper), a shaft
+/// towards a light triangle (or its quad) pays from 2 rays (19% faster there, 30% at 3; 1: 2%
+/// slower), a hemisphere, which keeps more triangles, from 4 (12% faster; 6: 30%; 2: 24% slower).
+const MIN_SHAFT_RAYS: u32 = 2;
+const MIN_HEMISPHERE_RAYS: u32 = 4;
 
 /// Scenes with more triangles than this never batch a hemisphere: an unbounded half-space above a
 /// surface holds a sizeable part of any such scene, far more than `MAX_CANDIDATE_BLOCKS` blocks, and
