@@ -2,7 +2,7 @@
 //! light triangle, the N ambient-occlusion rays of a hemisphere).
 //!
 //! Once per origin, the BVH is walked with a convex region instead of a ray (the shaft from the
-//! origin to the light triangle, or the half-space above the surface) to gather the few triangles
+//! origin to the light triangle or quad, or the half-space above the surface) to gather the few triangles
 //! that can block any ray of the batch. For each of them the Plücker edge vectors
 //! `(vi - o) x (vj - o)` are precomputed; a ray `o + t d` then crosses the triangle iff the three
 //! `d . edge` share a sign, and the distance needs one more dot product: four dot products per
@@ -10,8 +10,8 @@
 //! SSE operation; `occluded_lanes` (what the integrators use) tests each triangle against up to 32
 //! rays at once, ray-major, with the same operations, so both give the same answers.
 //!
-//! The walk is generic in the BVH's width and kernel; the candidates are repacked four to a
-//! Plücker block whatever that width.
+//! The walk is generic in the BVH's width and kernel; the candidates go four to a Plücker block
+//! whatever that width: four kept side by side in a leaf block as they lie, the others repacked.
 //!
 //! Watertight like the Woop test: the two triangles sharing an edge compute its vector from the
 //! same two corner vectors in swapped order, so one is exactly the negation of the other and a ray
@@ -24,7 +24,7 @@ use std::mem::MaybeUninit;
 use glam::{Vec3, Vec4};
 
 use super::bvh2::MAX_DEPTH;
-use super::simd::{F32x4, LaneMask, Lanes, all_lanes};
+use super::simd::{F32x4, LaneMask, Lanes, all_lanes, max_ps, min_ps};
 use super::wide::{LEAF_BIT, WideBvh, leaf_blocks};
 use crate::math::Ray;
 
@@ -402,18 +402,6 @@ impl OriginBatch {
         }
         blocked.iter().enumerate().fold(0, |mask, (i, &b)| mask | u32::from(b) << i)
     }
-}
-
-/// `_mm_min_ps(a, b)` on one lane (`b` when either is NaN), as `F32x4::min` in the ray-by-ray test.
-#[inline(always)]
-fn min_ps(a: f32, b: f32) -> f32 {
-    if a < b { a } else { b }
-}
-
-/// `_mm_max_ps(a, b)` on one lane.
-#[inline(always)]
-fn max_ps(a: f32, b: f32) -> f32 {
-    if a > b { a } else { b }
 }
 
 /// Writes to `block` the edge vectors and planes of four triangles (`corners[corner][axis]`, a

@@ -84,6 +84,19 @@ pub trait LaneMask: Copy + Debug + BitAnd<Output = Self> + BitOr<Output = Self> 
     fn bits(self) -> u32;
 }
 
+/// `_mm_min_ps(a, b)` on one lane: `b` where either is NaN, as every kernel's `min`. Loops over
+/// lanes that must round like the kernels (packets, ray-major batches) use it.
+#[inline(always)]
+pub fn min_ps(a: f32, b: f32) -> f32 {
+    if a < b { a } else { b }
+}
+
+/// `_mm_max_ps(a, b)` on one lane: `b` where either is NaN, as every kernel's `max`.
+#[inline(always)]
+pub fn max_ps(a: f32, b: f32) -> f32 {
+    if a > b { a } else { b }
+}
+
 /// The lanes whose bits are set in `mask`, in increasing order.
 #[inline(always)]
 pub fn lanes_of(mask: u32) -> impl Iterator<Item = usize> {

@@ -17,7 +17,7 @@ use super::leaf::{self, LEAF_BIT};
 use super::node::{EMPTY_CHILD, TriangleBlock, WideNode};
 use super::traverse::Stack;
 use crate::accel::Hit;
-use crate::accel::simd::{F32x4, Lanes, lanes_of};
+use crate::accel::simd::{F32x4, Lanes, lanes_of, max_ps, min_ps};
 use crate::accel::slab::{BOX_EXPANSION, PRUNE_SLACK, safe_reciprocal};
 use crate::geometry::triangle::{CANCELLATION_ERROR, WatertightRay, dominant_axis, intersect_triangle};
 use crate::math::Ray;
@@ -165,12 +165,6 @@ impl<const N: usize> RayPacket<N> {
     }
 }
 
-/// `_mm_max_ps(a, b)` on one lane: `b` when either is NaN, as the single-ray kernels compute it.
-#[inline(always)]
-fn max_ps(a: f32, b: f32) -> f32 {
-    if a > b { a } else { b }
-}
-
 /// The least entry distance of any lane, entering or not: a lower bound of the entering lanes'
 /// (which is all that ordering and pruning boxes need), four lanes at a time. The running minimum
 /// over the entering lanes it replaces compiled to a chain of `N` dependent scalar steps (a seventh
@@ -184,12 +178,6 @@ fn least<const N: usize>(values: &[f32; N]) -> f32 {
     }
     let [a, b, c, d] = low.to_array();
     quads.remainder().iter().fold(min_ps(min_ps(a, b), min_ps(c, d)), |m, &v| min_ps(m, v))
-}
-
-/// `_mm_min_ps(a, b)` on one lane.
-#[inline(always)]
-fn min_ps(a: f32, b: f32) -> f32 {
-    if a < b { a } else { b }
 }
 
 /// The closest hits found so far, one per lane (`t` infinite and id `u32::MAX` for none).
