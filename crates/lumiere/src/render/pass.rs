@@ -51,14 +51,26 @@ pub(super) fn pass_buffer(width: u32, height: u32) -> Vec<[f32; 3]> {
 pub(crate) fn camera_sample<'a>(
     camera: &Camera,
     sampler: &'a Sampler,
-    (x, y): (u32, u32),
+    pixel: (u32, u32),
     sample: u32,
     pixel_centre: bool,
 ) -> (Ray, SampleStream<'a>) {
+    let (position, stream) = film_position(camera, sampler, pixel, sample, pixel_centre);
+    (camera.ray(position.x, position.y), stream)
+}
+
+/// The film position of [`camera_sample`] (whose ray [`Camera::rays`] gives for many at once).
+fn film_position<'a>(
+    camera: &Camera,
+    sampler: &'a Sampler,
+    (x, y): (u32, u32),
+    sample: u32,
+    pixel_centre: bool,
+) -> (Vec2, SampleStream<'a>) {
     let mut stream = SampleStream::new(sampler, y * camera.width + x, sample);
     let jitter = stream.next_points(1);
     let offset = if pixel_centre { Vec2::splat(0.5) } else { jitter.get_2d(0) };
-    (camera.ray(x as f32 + offset.x, y as f32 + offset.y), stream)
+    (Vec2::new(x as f32 + offset.x, y as f32 + offset.y), stream)
 }
 
 /// Shades one sample per pixel into `buffer` (one value per pixel, row by row, as the integrator
@@ -133,10 +145,14 @@ fn shade_tile<I: Integrator>(
                 // Dead lanes repeat the block's first pixel (always inside the tile).
                 let (x, y) = if live & (1 << lane) != 0 { pixel(lane) } else { (bx, by) };
                 let image_pixel = ((tile.x0 + x) as u32, (tile.y0 + y) as u32);
-                camera_sample(camera, pass.sampler, image_pixel, pass.sample, pass.pixel_centre)
+                film_position(camera, pass.sampler, image_pixel, pass.sample, pass.pixel_centre)
             });
-            let packet =
-                CameraPacket { rays: samples.map(|(ray, _)| ray), streams: samples.map(|(_, stream)| stream), live };
+            let (xs, ys) = (samples.map(|(p, _)| p.x), samples.map(|(p, _)| p.y));
+            let rays = world.simd(
+                #[inline(always)]
+                || camera.rays(&xs, &ys),
+            );
+            let packet = CameraPacket { rays, streams: samples.map(|(_, stream)| stream), live };
             let radiance = integrator.radiance_packet(world, &packet, &mut ctx);
             for lane in packet.lanes() {
                 let (x, y) = pixel(lane);

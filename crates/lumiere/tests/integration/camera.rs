@@ -67,3 +67,39 @@ fn look_at_rejects_degenerate_frames() {
     assert!(Camera::look_at(Vec3::ZERO, Vec3::Y, Vec3::Y, 45.0, 10, 10).is_err());
     assert!(Camera::look_at(Vec3::ZERO, Vec3::Z, Vec3::Y, 180.0, 10, 10).is_err());
 }
+
+/// Many rays at once are the rays one at a time, bit for bit, for both projections: film corners,
+/// pixel centres, jittered positions and positions off the film.
+#[test]
+fn rays_at_once_are_the_rays_one_at_a_time() {
+    let gkit = Camera::from_orbiter(&orbiter_2022(), 1024, 768);
+    let pinhole = Camera::look_at(Vec3::new(0.3, 1.0, 3.9), Vec3::new(0.0, 1.0, 0.0), Vec3::Y, 45.0, 640, 480)
+        .expect("a valid look-at camera");
+    let mut state = 0x9e37_79b9_u32;
+    let mut next = || {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        state as f32 / u32::MAX as f32
+    };
+    for camera in [&gkit, &pinhole] {
+        let (w, h) = (camera.width as f32, camera.height as f32);
+        for round in 0..64 {
+            let (xs, ys): ([f32; 16], [f32; 16]) = match round {
+                0 => (
+                    [0.0, w, 0.0, w, 0.5, w - 0.5, 0.5, w - 0.5, w / 2.0, -1.0, w + 1.0, 0.25, 1e-3, 7.5, 3.0, 9.0],
+                    [0.0, 0.0, h, h, 0.5, 0.5, h - 0.5, h - 0.5, h / 2.0, -1.0, h + 1.0, 0.75, 1e-3, 2.5, 5.0, 1.0],
+                ),
+                _ => (std::array::from_fn(|_| next() * w), std::array::from_fn(|_| next() * h)),
+            };
+            let rays = camera.rays(&xs, &ys);
+            for lane in 0..16 {
+                let one = camera.ray(xs[lane], ys[lane]);
+                let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+                assert_eq!(bits(rays[lane].origin), bits(one.origin), "({}, {})", xs[lane], ys[lane]);
+                assert_eq!(bits(rays[lane].dir), bits(one.dir), "({}, {})", xs[lane], ys[lane]);
+                assert_eq!(rays[lane].tmax.to_bits(), one.tmax.to_bits());
+            }
+        }
+    }
+}
