@@ -9,6 +9,8 @@ use crate::world::World;
 pub struct Hits;
 
 impl Integrator for Hits {
+    const PACKETS: bool = true;
+
     fn radiance(&self, world: &World, ray: &Ray, ctx: &mut SampleContext) -> Vec3 {
         ctx.rays += 1;
         if world.occluded(ray) { Vec3::ONE } else { Vec3::ZERO }

@@ -126,6 +126,13 @@ impl CameraPacket<'_> {
 /// Radiance along a camera ray. Implemented by plain structs and used through generics, so the
 /// per-ray path has no dynamic dispatch.
 pub trait Integrator: Sync {
+    /// Whether [`Integrator::radiance_packet`] traces the packet's rays together, in the ISA's
+    /// full vector width ([`World::simd`]); the pass then computes the camera rays in that width
+    /// too. Integrators that trace one ray at a time keep them in the baseline width: computing them
+    /// in 512-bit registers made the path tracer, which runs no 512-bit code of its own, 6-7% slower
+    /// (a change of clock licence or of register state; this machine could not tell which).
+    const PACKETS: bool = false;
+
     fn radiance(&self, world: &World, ray: &Ray, ctx: &mut SampleContext) -> Vec3;
 
     /// The radiance of every live lane of `camera` (zero elsewhere): exactly what
@@ -155,6 +162,8 @@ pub trait ShadesClosestHit: Sync {
 }
 
 impl<T: ShadesClosestHit> Integrator for T {
+    const PACKETS: bool = true;
+
     fn radiance(&self, world: &World, ray: &Ray, ctx: &mut SampleContext) -> Vec3 {
         ctx.rays += 1;
         self.shade(world, ray, world.intersect(ray), ctx)

@@ -15,6 +15,8 @@ use crate::world::World;
 pub struct Shadows;
 
 impl Integrator for Shadows {
+    const PACKETS: bool = true;
+
     fn radiance(&self, world: &World, ray: &Ray, ctx: &mut SampleContext) -> Vec3 {
         ctx.rays += 1;
         let receiver = match Receiver::new(world, ray, world.intersect(ray)) {

@@ -148,10 +148,14 @@ fn shade_tile<I: Integrator>(
                 film_position(camera, pass.sampler, image_pixel, pass.sample, pass.pixel_centre)
             });
             let (xs, ys) = (samples.map(|(p, _)| p.x), samples.map(|(p, _)| p.y));
-            let rays = world.simd(
-                #[inline(always)]
-                || camera.rays(&xs, &ys),
-            );
+            let rays = if I::PACKETS {
+                world.simd(
+                    #[inline(always)]
+                    || camera.rays(&xs, &ys),
+                )
+            } else {
+                camera.rays(&xs, &ys)
+            };
             let packet = CameraPacket { rays, streams: samples.map(|(_, stream)| stream), live };
             let radiance = integrator.radiance_packet(world, &packet, &mut ctx);
             for lane in packet.lanes() {
