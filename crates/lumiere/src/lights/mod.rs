@@ -8,6 +8,8 @@
 mod area;
 mod quad;
 
+use std::sync::OnceLock;
+
 use glam::{Vec2, Vec3};
 
 pub use area::AreaLight;
@@ -56,8 +58,15 @@ pub struct LightSet {
     light_of_triangle: Vec<u32>,
     /// Power-proportional choice; `None` when there are no lights (or none has power).
     power: Option<AliasTable>,
-    /// Pairs of light triangles forming convex quads, and each light's quad (index into `quads`)
-    /// or `NOT_A_LIGHT`.
+    /// Pairs of light triangles forming convex quads, found when first asked for: only direct
+    /// lighting's per-light shafts use them, and with a million light triangles pairing them took
+    /// a second and 160 MB that other modes would pay for nothing.
+    quads: OnceLock<Quads>,
+}
+
+/// The quads, and each light's quad (index into `quads`) or `NOT_A_LIGHT`.
+#[derive(Clone, Debug)]
+struct Quads {
     quads: Vec<QuadLight>,
     quad_of_light: Vec<u32>,
 }
@@ -71,21 +80,25 @@ impl LightSet {
             light_of_triangle[light.triangle as usize] = index as u32;
         }
         let weights: Vec<f32> = lights.iter().map(|l| l.power().element_sum()).collect();
-        let quads = quad::pair_lights(&lights);
-        let mut quad_of_light = vec![NOT_A_LIGHT; lights.len()];
-        for (index, quad) in quads.iter().enumerate() {
-            for light in quad.lights {
-                quad_of_light[light as usize] = index as u32;
-            }
-        }
-        LightSet { lights, light_of_triangle, power: AliasTable::new(&weights), quads, quad_of_light }
+        LightSet { lights, light_of_triangle, power: AliasTable::new(&weights), quads: OnceLock::new() }
     }
 
     /// The convex quad light `light` forms with another light triangle, and its index, if any.
+    /// The first call pairs all the lights (the same pairs whichever thread makes it).
     #[inline]
     pub fn quad_of(&self, light: u32) -> Option<(u32, &QuadLight)> {
-        let index = *self.quad_of_light.get(light as usize)?;
-        (index != NOT_A_LIGHT).then(|| (index, &self.quads[index as usize]))
+        let Quads { quads, quad_of_light } = self.quads.get_or_init(|| {
+            let quads = quad::pair_lights(&self.lights);
+            let mut quad_of_light = vec![NOT_A_LIGHT; self.lights.len()];
+            for (index, quad) in quads.iter().enumerate() {
+                for light in quad.lights {
+                    quad_of_light[light as usize] = index as u32;
+                }
+            }
+            Quads { quads, quad_of_light }
+        });
+        let index = *quad_of_light.get(light as usize)?;
+        (index != NOT_A_LIGHT).then(|| (index, &quads[index as usize]))
     }
 
     pub fn lights(&self) -> &[AreaLight] {
