@@ -83,12 +83,11 @@ impl Region {
             [origin, corners[2], corners[0]],
             [corners[0], corners[1], corners[2]],
         ];
-        let size = corners.iter().map(|c| (*c - origin).length()).fold(0.0f32, f32::max);
         let mut planes = [Vec4::ZERO; MAX_PLANES];
         for (plane, [a, b, c]) in planes.iter_mut().zip(faces) {
             *plane = plane_facing(a, b, c, centroid)?;
         }
-        let margin = -tolerance(origin, size);
+        let margin = -tolerance(origin, &corners);
         // The segments end on the triangle `corners` (the light's shadow targets): nothing on or
         // beyond its plane can block them.
         Some(Region { planes, keep_above: [margin, margin, margin, 0.0, 0.0], count: 4 })
@@ -103,12 +102,11 @@ impl Region {
             return None;
         }
         let centroid = (origin + corners[0] + corners[1] + corners[2] + corners[3]) * 0.2;
-        let size = corners.iter().map(|c| (*c - origin).length()).fold(0.0f32, f32::max);
         let mut planes = [plane; MAX_PLANES];
         for (k, side) in planes.iter_mut().take(4).enumerate() {
             *side = plane_facing(origin, corners[k], corners[(k + 1) % 4], centroid)?;
         }
-        let margin = -tolerance(origin, size);
+        let margin = -tolerance(origin, &corners);
         Some(Region { planes, keep_above: [margin, margin, margin, margin, 0.0], count: 5 })
     }
 
@@ -173,8 +171,10 @@ fn plane_distance<const W: usize, L: Lanes<W>>(plane: &Vec4, points: &[[f32; W];
         + L::splat(plane.w)
 }
 
-/// A few thousand ulps of the region's coordinates: far above rounding, far below any geometry.
-fn tolerance(origin: Vec3, size: f32) -> f32 {
+/// A few thousand ulps of the coordinates of a shaft from `origin` to `corners`: far above
+/// rounding, far below any geometry.
+fn tolerance(origin: Vec3, corners: &[Vec3]) -> f32 {
+    let size = corners.iter().map(|c| (*c - origin).length()).fold(0.0f32, f32::max);
     4096.0 * f32::EPSILON * (origin.abs().max_element() + size)
 }
 

@@ -232,9 +232,12 @@ impl ShadesClosestHit for Direct {
                         continue;
                     }
                     let quad = lights.quad_of(index as u32);
-                    if quad.is_none() || quad.map(|(q, _)| q) != batch_quad {
-                        let quad_shaft = quad
-                            .and_then(|(q, quad)| Some((q, Region::shaft_to_quad(origin, quad.corners, quad.plane)?)));
+                    if quad.is_none_or(|(q, _)| batch_quad != Some(q)) {
+                        // The shaft to the quad, or to the triangle alone where the receiver is not
+                        // in front of the quad's plane (or the light has no quad).
+                        let quad_shaft = quad.and_then(|(q, quad)| {
+                            Region::shaft_to_quad(origin, quad.corners, quad.plane).map(|shaft| (q, shaft))
+                        });
                         batch_quad = quad_shaft.map(|(q, _)| q);
                         let shaft = quad_shaft.map(|(_, shaft)| shaft);
                         let Some(shaft) = shaft.or_else(|| Region::shaft(origin, light.shadow_targets)) else {

@@ -61,14 +61,7 @@ pub struct LightSet {
     /// Pairs of light triangles forming convex quads, found when first asked for: only direct
     /// lighting's per-light shafts use them, and with a million light triangles pairing them took
     /// a second and 160 MB that other modes would pay for nothing.
-    quads: OnceLock<Quads>,
-}
-
-/// The quads, and each light's quad (index into `quads`) or `NOT_A_LIGHT`.
-#[derive(Clone, Debug)]
-struct Quads {
-    quads: Vec<QuadLight>,
-    quad_of_light: Vec<u32>,
+    quads: OnceLock<quad::Quads>,
 }
 
 impl LightSet {
@@ -87,18 +80,9 @@ impl LightSet {
     /// The first call pairs all the lights (the same pairs whichever thread makes it).
     #[inline]
     pub fn quad_of(&self, light: u32) -> Option<(u32, &QuadLight)> {
-        let Quads { quads, quad_of_light } = self.quads.get_or_init(|| {
-            let quads = quad::pair_lights(&self.lights);
-            let mut quad_of_light = vec![NOT_A_LIGHT; self.lights.len()];
-            for (index, quad) in quads.iter().enumerate() {
-                for light in quad.lights {
-                    quad_of_light[light as usize] = index as u32;
-                }
-            }
-            Quads { quads, quad_of_light }
-        });
+        let quad::Quads { quads, quad_of_light } = self.quads.get_or_init(|| quad::pair_lights(&self.lights));
         let index = *quad_of_light.get(light as usize)?;
-        (index != NOT_A_LIGHT).then(|| (index, &quads[index as usize]))
+        (index != quad::NO_QUAD).then(|| (index, &quads[index as usize]))
     }
 
     pub fn lights(&self) -> &[AreaLight] {

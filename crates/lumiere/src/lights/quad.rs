@@ -30,45 +30,58 @@ pub struct QuadLight {
 /// gives two normals equal to a few ulps).
 const COPLANAR_COSINE: f32 = 1.0 - 1e-5;
 
+/// The quads of a light list, and each light's quad.
+#[derive(Clone, Debug)]
+pub(super) struct Quads {
+    pub quads: Vec<QuadLight>,
+    /// Per light, the index of its quad in `quads`, or `NO_QUAD`.
+    pub quad_of_light: Vec<u32>,
+}
+
+pub(super) const NO_QUAD: u32 = u32::MAX;
+
 /// Pairs the lights into quads where they can be: each light belongs to at most one quad; two
 /// lights pair when they share an edge (its two vertices, bit for bit), their normals agree and
 /// the four corners turn the same way at each corner (a strictly convex quad). Linear in the
 /// number of lights (edges are matched through a hash map).
-pub(super) fn pair_lights(lights: &[AreaLight]) -> Vec<QuadLight> {
-    let key = |v: Vec3| v.to_array().map(f32::to_bits);
+pub(super) fn pair_lights(lights: &[AreaLight]) -> Quads {
+    // Edge `k` of a light (corners `k` and `k + 1`), whichever way it runs.
+    let edge = |light: &AreaLight, k: usize| {
+        let key = |v: Vec3| v.to_array().map(f32::to_bits);
+        let (a, b) = (key(light.vertices[k]), key(light.vertices[(k + 1) % 3]));
+        if a < b { (a, b) } else { (b, a) }
+    };
     let mut by_edge: HashMap<([u32; 3], [u32; 3]), Vec<u32>> = HashMap::new();
     for (index, light) in lights.iter().enumerate() {
         for k in 0..3 {
-            let (a, b) = (key(light.vertices[k]), key(light.vertices[(k + 1) % 3]));
-            by_edge.entry(if a < b { (a, b) } else { (b, a) }).or_default().push(index as u32);
+            by_edge.entry(edge(light, k)).or_default().push(index as u32);
         }
     }
-    let mut paired = vec![false; lights.len()];
     let mut quads = Vec::new();
+    let mut quad_of_light = vec![NO_QUAD; lights.len()];
     // Visited in light order, so that the pairing does not depend on the map's iteration order.
     for (index, light) in lights.iter().enumerate() {
         for k in 0..3 {
-            if paired[index] {
+            if quad_of_light[index] != NO_QUAD {
                 break;
             }
-            let (a, b) = (key(light.vertices[k]), key(light.vertices[(k + 1) % 3]));
             // An edge of exactly two lights (a fan of three or more around one edge is no quad).
-            let sharing = &by_edge[&if a < b { (a, b) } else { (b, a) }];
+            let sharing = &by_edge[&edge(light, k)];
             if sharing.len() != 2 {
                 continue;
             }
             let other = if sharing[0] as usize == index { sharing[1] } else { sharing[0] };
-            if paired[other as usize] {
+            if quad_of_light[other as usize] != NO_QUAD {
                 continue;
             }
             if let Some(quad) = quad_of(lights, index as u32, other, k) {
-                paired[index] = true;
-                paired[other as usize] = true;
+                quad_of_light[index] = quads.len() as u32;
+                quad_of_light[other as usize] = quads.len() as u32;
                 quads.push(quad);
             }
         }
     }
-    quads
+    Quads { quads, quad_of_light }
 }
 
 /// The quad of lights `first` and `second`, which share `first`'s edge `edge` (vertices `edge` and

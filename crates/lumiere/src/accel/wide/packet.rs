@@ -120,7 +120,12 @@ impl<const N: usize> RayPacket<N> {
     #[inline(always)]
     fn enter<const W: usize>(&self, node: &WideNode<W>, child: usize, limit: &[f32; N]) -> (u32, f32) {
         let bounds = std::array::from_fn(|row| node.bounds[row][child]);
-        self.enter_box(&bounds, limit)
+        let (near, far) = self.slabs(&bounds, limit);
+        let mut mask = 0u32;
+        for lane in 0..N {
+            mask |= u32::from(near[lane] <= far[lane]) << lane;
+        }
+        (mask, least(&near))
     }
 
     /// Whether any lane enters the box of triangle `lane_in_block` of `block` before `limit` (the
@@ -134,17 +139,6 @@ impl<const N: usize> RayPacket<N> {
         let (near, far) = self.slabs(&bounds, limit);
         // Any lane, without building the lane mask.
         near.iter().zip(&far).fold(false, |any, (n, f)| any | (n <= f))
-    }
-
-    /// [`RayPacket::enter`] for a box given as its rows (min x, y, z, then max x, y, z).
-    #[inline(always)]
-    fn enter_box(&self, bounds: &[f32; 6], limit: &[f32; N]) -> (u32, f32) {
-        let (near, far) = self.slabs(bounds, limit);
-        let mut mask = 0u32;
-        for lane in 0..N {
-            mask |= u32::from(near[lane] <= far[lane]) << lane;
-        }
-        (mask, least(&near))
     }
 
     /// Each lane's entry and exit distances of a box given as its rows, the exit clipped to `limit`.
@@ -373,12 +367,11 @@ impl<const W: usize, L> WideBvh<W, L> {
             if nearest > farthest_limit * PRUNE_SLACK {
                 continue;
             }
+            let limit = tmax.map(|t| t * PRUNE_SLACK);
             if reference & LEAF_BIT == 0 {
-                let limit = tmax.map(|t| t * PRUNE_SLACK);
                 push_children(&mut stack, packet, &self.nodes[reference as usize], &limit);
                 continue;
             }
-            let limit = tmax.map(|t| t * PRUNE_SLACK);
             for block in &self.blocks[leaf::blocks::<W>(reference)] {
                 for lane_in_block in (0..W).filter(|&l| !is_padding(block, l)) {
                     if use_boxes {
