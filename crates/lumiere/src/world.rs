@@ -3,6 +3,7 @@
 
 use glam::{Vec2, Vec3};
 
+use crate::accel::simd::lanes_of;
 use crate::accel::{Accel, BuildPreset, Hit, Isa, OriginBatch, Region};
 use crate::geometry::surface::SurfacePoint;
 use crate::lights::LightSet;
@@ -22,6 +23,14 @@ pub struct World {
     /// Each material's diffuse texture, decoded once.
     texture_of_material: Vec<Option<TextureId>>,
     textures: TextureSet,
+    /// Each material's coverage texture (`map_d`), decoded once: rays pass through its surface
+    /// where the coverage is below one half ([`World::opaque_at`]).
+    cutout_of_material: Vec<Option<TextureId>>,
+    cutouts: TextureSet,
+    /// Whether any material has a coverage texture. Without one (most scenes) every query goes
+    /// straight to the BVH, its packets and batches; with one, each ray is traced alone, and each
+    /// hit on a cutout material is tested against its texture.
+    has_cutouts: bool,
     /// What could not be derived (textures that failed to load), for the user to see.
     warnings: Vec<String>,
 }
@@ -41,9 +50,24 @@ impl World {
         let accel = Accel::build(&scene.mesh.positions, &scene.mesh.indices, preset, isa);
         let lights = LightSet::new(&scene);
         let kinds = scene.materials.iter().map(Material::kind).collect();
-        let (texture_of_material, textures, warnings) =
+        let (texture_of_material, textures, mut warnings) =
             TextureSet::for_materials(scene.materials.iter().map(|m| m.map_kd.as_deref()));
-        World { scene, accel, lights, kinds, texture_of_material, textures, warnings }
+        let (cutout_of_material, cutouts, cutout_warnings) =
+            TextureSet::for_cutouts(scene.materials.iter().map(|m| m.map_d.as_deref()));
+        warnings.extend(cutout_warnings);
+        let has_cutouts = cutout_of_material.iter().any(Option::is_some);
+        World {
+            scene,
+            accel,
+            lights,
+            kinds,
+            texture_of_material,
+            textures,
+            cutout_of_material,
+            cutouts,
+            has_cutouts,
+            warnings,
+        }
     }
 
     pub fn scene(&self) -> &Scene {
@@ -98,6 +122,9 @@ impl World {
     /// The closest hit along `ray` within `[0, ray.tmax]`.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        if self.has_cutouts {
+            return self.accel.intersect_filtered(ray, &|id, u, v| self.opaque_at(id, u, v));
+        }
         self.accel.intersect(ray)
     }
 
@@ -105,6 +132,11 @@ impl World {
     /// where they are coherent (see [`Accel::intersect_packet`]); the same hits.
     #[inline]
     pub fn intersect_packet<const N: usize>(&self, rays: &[Ray; N], live: u32) -> [Option<Hit>; N] {
+        if self.has_cutouts {
+            return std::array::from_fn(
+                |lane| if live & (1 << lane) != 0 { self.intersect(&rays[lane]) } else { None },
+            );
+        }
         self.accel.intersect_packet(rays, live)
     }
 
@@ -112,19 +144,38 @@ impl World {
     /// bit `i` set if ray `i` is blocked.
     #[inline]
     pub fn occluded_packet<const N: usize>(&self, rays: &[Ray; N], live: u32) -> u32 {
+        if self.has_cutouts {
+            return lanes_of(live).fold(0, |blocked, lane| blocked | u32::from(self.occluded(&rays[lane])) << lane);
+        }
         self.accel.occluded_packet(rays, live)
     }
 
     /// Whether anything lies along `ray` within `[0, ray.tmax]`.
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
+        if self.has_cutouts {
+            return self.accel.occluded_filtered(ray, &|id, u, v| self.opaque_at(id, u, v));
+        }
         self.accel.occluded(ray)
+    }
+
+    /// Whether triangle `id` is there at barycentrics `(u, v)` of its second and third corners:
+    /// false where its material's coverage texture (`map_d`) is below one half, the alpha test of
+    /// cutout leaves and fences.
+    fn opaque_at(&self, id: u32, u: f32, v: f32) -> bool {
+        let material = self.scene.mesh.material_ids[id as usize] as usize;
+        let Some(texture) = self.cutout_of_material[material] else { return true };
+        let uv = self.interpolated_texcoord(id as usize, 1.0 - u - v, u, v);
+        self.cutouts.get(texture).sample_coverage(uv) >= 0.5
     }
 
     /// Readies `batch` for `rays` rays leaving `origin` inside `region`: gathers their candidate
     /// triangles, or notes that they are cheaper traced one by one (see [`OriginBatch`]).
     #[inline]
     pub fn prepare_batch(&self, batch: &mut OriginBatch, origin: Vec3, region: &Region, rays: u32) {
+        // A batch's triangles know nothing of cutouts: with them, its rays are traced one by one
+        // (no ray count pays for a gather).
+        let rays = if self.has_cutouts { 0 } else { rays };
         self.accel.prepare_batch(batch, origin, region, rays);
     }
 
@@ -144,12 +195,19 @@ impl World {
         tmax: f32,
         live: u32,
     ) -> u32 {
+        if self.has_cutouts {
+            let ray = |lane: usize| Ray { origin: batch.origin(), dir: Vec3::from(dirs.map(|d| d[lane])), tmax };
+            return lanes_of(live).fold(0, |blocked, lane| blocked | u32::from(self.occluded(&ray(lane))) << lane);
+        }
         self.accel.occluded_lanes_in_batch(batch, dirs, tmax, live)
     }
 
     /// [`World::occluded`] for a ray of a batch prepared with [`World::prepare_batch`].
     #[inline]
     pub fn occluded_in_batch(&self, batch: &OriginBatch, ray: &Ray) -> bool {
+        if self.has_cutouts {
+            return self.occluded(ray);
+        }
         self.accel.occluded_in_batch(batch, ray)
     }
 

@@ -59,11 +59,14 @@ fn line(key: &str, value: impl Display) -> Result<()> {
     output::print(format_args!("{key:<11}{value}"))
 }
 
-/// What lumiere uses of a material: its colour, its texture, its emission.
+/// What lumiere uses of a material: its colour, its texture, its cutout mask, its emission.
 fn describe(material: &Material) -> String {
     let mut parts = vec![format!("Kd {}", vector(material.kd))];
     if let Some(texture) = &material.map_kd {
         parts.push(format!("map_Kd {:?}", texture.display().to_string()));
+    }
+    if let Some(mask) = &material.map_d {
+        parts.push(format!("map_d {:?} (cutout)", mask.display().to_string()));
     }
     if material.is_emissive() {
         parts.push(format!("Ke {} (a light)", vector(material.ke)));

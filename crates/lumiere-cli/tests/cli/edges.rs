@@ -183,6 +183,21 @@ fn outputs_that_are_inputs_or_each_other_are_refused() {
     assert_refused(&dir, &[&small[..], &["-o", &dir.arg("out")]].concat(), "has no extension");
 }
 
+/// The files a scene's materials name (a texture, a cutout mask) are inputs too.
+#[test]
+fn outputs_that_are_textures_or_masks_are_refused() {
+    let dir = TempDir::new("clobber-textures");
+    dir.write("m.mtl", "newmtl leaf\nmap_Kd colour.png\nmap_d mask.png\n");
+    let scene = dir.write("scene.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl leaf\nf 1 2 3\n");
+    dir.write("colour.png", "not decoded before the refusal");
+    dir.write("mask.png", "not decoded before the refusal");
+    let scene = scene.to_str().unwrap();
+    for file in ["colour.png", "mask.png"] {
+        let args = ["render", "--size", "8x6", scene, "-o", &dir.arg(file)];
+        assert_refused(&dir, &args, "which the scene reads");
+    }
+}
+
 #[test]
 fn stats_go_to_stdout_with_a_dash() {
     let dir = TempDir::new("stats-stdout");

@@ -98,6 +98,7 @@ const NASTY: &[&[u8]] = &[
     b"d -halo",
     b"illum",
     b"map_Kd",
+    b"map_d",
     b"c",
     b"p",
     b"r",

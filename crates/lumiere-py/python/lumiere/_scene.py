@@ -129,9 +129,9 @@ class Scene:
 
     def info(self) -> Dict[str, Any]:
         """What ``lumiere info`` prints: ``name``, ``triangles``, ``vertices``, ``materials`` (by
-        name: ``triangles``, ``kd``, ``ke``, ``texture``, ``light``), ``lights`` (``triangles``,
-        ``area``, ``power``), ``bounds`` (``(min, max)`` or None), ``warnings``, load and build
-        seconds."""
+        name: ``triangles``, ``kd``, ``ke``, ``texture``, ``cutout`` (its ``map_d`` mask),
+        ``light``), ``lights`` (``triangles``, ``area``, ``power``), ``bounds`` (``(min, max)`` or
+        None), ``warnings``, load and build seconds."""
         return self._native.info()
 
     @property

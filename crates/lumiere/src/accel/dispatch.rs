@@ -128,6 +128,19 @@ impl Accel {
         with_bvh!(self, bvh => bvh.occluded(ray))
     }
 
+    /// As [`Accel::intersect`], ignoring the hits `keep(triangle, u, v)` refuses: the closest hit
+    /// it accepts (cutout surfaces).
+    #[inline]
+    pub fn intersect_filtered(&self, ray: &Ray, keep: &dyn Fn(u32, f32, f32) -> bool) -> Option<Hit> {
+        with_bvh!(self, bvh => bvh.intersect_filtered(ray, keep))
+    }
+
+    /// As [`Accel::occluded`], counting only the hits `keep(triangle, u, v)` accepts.
+    #[inline]
+    pub fn occluded_filtered(&self, ray: &Ray, keep: &dyn Fn(u32, f32, f32) -> bool) -> bool {
+        with_bvh!(self, bvh => bvh.occluded_filtered(ray, keep))
+    }
+
     /// As [`Accel::occluded`], counting nodes and blocks visited into `stats`.
     pub fn occluded_counted(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
         with_bvh!(self, bvh => bvh.occluded_counted(ray, stats))

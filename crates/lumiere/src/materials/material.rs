@@ -42,10 +42,13 @@ pub struct Material {
     /// Diffuse texture, resolved relative to the MTL file; where it decodes, its value at the hit
     /// replaces `kd` as the base colour.
     pub map_kd: Option<PathBuf>,
+    /// Coverage texture (MTL `map_d`), resolved relative to the MTL file: where its coverage is
+    /// below one half the surface is cut out (rays pass through it), as leaves and fences are drawn.
+    pub map_d: Option<PathBuf>,
     /// Index of refraction (MTL `Ni`) of a transmissive material.
     pub ni: f32,
     /// Opacity (`d`, or `1 − Tr`), 1 = opaque. Below 1 together with an explicit `Ni`, the surface
-    /// is glass; otherwise it is not honoured (no alpha blending or cutouts yet).
+    /// is glass; otherwise it is not honoured (no alpha blending: cutouts come from `map_d`).
     pub dissolve: f32,
     /// MTL illumination model: 0–1 switch the specular layer off, 2 on, 3/5/8 make it a mirror,
     /// 4/6/7/9 make the surface glass (see [`Material::kind`]).
@@ -126,6 +129,7 @@ impl Material {
             ns: 0.0,
             ke: Vec3::ZERO,
             map_kd: None,
+            map_d: None,
             ni: 1.0,
             dissolve: 1.0,
             illum: 1,

@@ -26,6 +26,12 @@ pub fn scene_fingerprint(scene: &Scene) -> u64 {
         h.write_f32s([m.metallic, m.roughness].map(|v| v.unwrap_or(f32::NAN)));
         h.write_u32(m.illum);
         h.write(m.map_kd.as_deref().map_or(&b""[..], |p| p.as_os_str().as_encoded_bytes()));
+        // Only where present, so that the fingerprints of scenes without cutouts (and their
+        // checkpoints) stay what they were before `map_d` was read.
+        if let Some(map_d) = &m.map_d {
+            h.write(b"map_d");
+            h.write(map_d.as_os_str().as_encoded_bytes());
+        }
     }
     h.finish()
 }

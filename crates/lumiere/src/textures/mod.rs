@@ -4,7 +4,8 @@
 //!
 //! * **Colour.** PNG and JPEG store sRGB-encoded values; each channel is decoded with the exact
 //!   sRGB curve (IEC 61966-2-1: linear below 0.04045, a 2.4 power above), so texture values are
-//!   reflectances, like `Kd`. Alpha is linear coverage and is kept as is, for later cutouts.
+//!   reflectances, like `Kd`. Alpha is linear coverage and is kept as is, for cutouts (`map_d`,
+//!   [`Texture::sample_coverage`]).
 //! * **Coordinates.** OBJ's texture origin is the bottom-left corner: `v = 0` is the *last* row of
 //!   the image, `v = 1` the first. Texel `(x, y)` (column, row from the top) has its centre at
 //!   `u = (x + ½) / width`, `v = 1 − (y + ½) / height`. Outside `[0, 1)` coordinates repeat; at the
@@ -72,6 +73,20 @@ impl Texels {
                 Vec3::new(table[r as usize], table[g as usize], table[b as usize])
             }
             Texels::Linear(rgb) => rgb[i],
+        }
+    }
+
+    /// Texel `i` read as a scalar (a coverage mask without an alpha channel): the luminance of its
+    /// stored values, 8-bit codes over 255 as they are (a mask is not a colour: no sRGB decoding),
+    /// or linear values.
+    #[inline]
+    fn scalar(&self, i: usize) -> f32 {
+        match self {
+            Texels::Srgb8 { codes, .. } => {
+                let [r, g, b, _] = codes[i].map(f32::from);
+                (0.2126 * r + 0.7152 * g + 0.0722 * b) / 255.0
+            }
+            Texels::Linear(rgb) => rgb[i].dot(Vec3::new(0.2126, 0.7152, 0.0722)),
         }
     }
 
@@ -199,6 +214,17 @@ impl Texture {
         self.footprint(uv).iter().map(|&(i, w)| alpha[i] * w).sum()
     }
 
+    /// The bilinearly filtered coverage at `uv`, for cutouts (`map_d`): the alpha channel where the
+    /// file has one, otherwise the image read as a scalar (the luminance of its 8-bit codes over
+    /// 255, as a grey mask is drawn), as renderers read a `map_d` file.
+    #[inline]
+    pub fn sample_coverage(&self, uv: Vec2) -> f32 {
+        if self.alpha.is_some() {
+            return self.sample_alpha(uv);
+        }
+        self.footprint(uv).iter().map(|&(i, w)| self.rgb.scalar(i) * w).sum()
+    }
+
     /// The four texels around `uv` and their bilinear weights (which sum to 1).
     #[inline]
     fn footprint(&self, uv: Vec2) -> [(usize, f32); 4] {
@@ -313,6 +339,12 @@ impl TextureSet {
     /// that decoded, with one warning for each path that did not, in the order of `paths`:
     /// `texture "PATH": REASON; the material's Kd is used instead`.
     pub fn load<P: AsRef<Path> + Sync>(paths: &[P]) -> (TextureSet, Vec<String>) {
+        TextureSet::load_or(paths, "the material's Kd is used instead")
+    }
+
+    /// [`TextureSet::load`], whose warnings end with `instead` (what the material does without
+    /// the texture).
+    fn load_or<P: AsRef<Path> + Sync>(paths: &[P], instead: &str) -> (TextureSet, Vec<String>) {
         let mut distinct: Vec<&Path> = Vec::new();
         for path in paths {
             if !distinct.contains(&path.as_ref()) {
@@ -328,8 +360,7 @@ impl TextureSet {
                     set.textures.push(texture);
                     set.paths.push(path.to_path_buf());
                 }
-                Err(reason) => warnings
-                    .push(format!("texture \"{}\": {reason}; the material's Kd is used instead", path.display())),
+                Err(reason) => warnings.push(format!("texture \"{}\": {reason}; {instead}", path.display())),
             }
         }
         (set, warnings)
@@ -341,10 +372,27 @@ impl TextureSet {
     pub fn for_materials<'a>(
         map_kd: impl IntoIterator<Item = Option<&'a Path>>,
     ) -> (Vec<Option<TextureId>>, TextureSet, Vec<String>) {
-        let map_kd: Vec<Option<&Path>> = map_kd.into_iter().collect();
-        let paths: Vec<&Path> = map_kd.iter().flatten().copied().collect();
-        let (set, warnings) = TextureSet::load(&paths);
-        let ids = map_kd.iter().map(|path| path.and_then(|p| set.id_of(p))).collect();
+        TextureSet::per_material(map_kd, "the material's Kd is used instead")
+    }
+
+    /// As [`TextureSet::for_materials`], for each material's coverage texture (`map_d`, for
+    /// cutouts): a file that fails leaves its material opaque.
+    pub fn for_cutouts<'a>(
+        map_d: impl IntoIterator<Item = Option<&'a Path>>,
+    ) -> (Vec<Option<TextureId>>, TextureSet, Vec<String>) {
+        TextureSet::per_material(map_d, "the material stays opaque")
+    }
+
+    /// One optional texture path per material → each material's texture id, the set, and the
+    /// warnings of [`TextureSet::load_or`].
+    fn per_material<'a>(
+        paths: impl IntoIterator<Item = Option<&'a Path>>,
+        instead: &str,
+    ) -> (Vec<Option<TextureId>>, TextureSet, Vec<String>) {
+        let paths: Vec<Option<&Path>> = paths.into_iter().collect();
+        let distinct: Vec<&Path> = paths.iter().flatten().copied().collect();
+        let (set, warnings) = TextureSet::load_or(&distinct, instead);
+        let ids = paths.iter().map(|path| path.and_then(|p| set.id_of(p))).collect();
         (ids, set, warnings)
     }
 

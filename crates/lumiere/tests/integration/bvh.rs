@@ -9,6 +9,17 @@ use lumiere::geometry::triangle::{WatertightRay, intersect_triangle, is_degenera
 use lumiere::math::Ray;
 
 fn brute_force(positions: &[Vec3], indices: &[[u32; 3]], ray: &Ray) -> Option<Hit> {
+    brute_force_filtered(positions, indices, ray, &|_, _, _| true)
+}
+
+/// Brute force keeping only the hits `keep(triangle, u, v)` accepts: the closest of those (equal
+/// `t`: the lower id, which is visited first).
+fn brute_force_filtered(
+    positions: &[Vec3],
+    indices: &[[u32; 3]],
+    ray: &Ray,
+    keep: &dyn Fn(u32, f32, f32) -> bool,
+) -> Option<Hit> {
     let wray = WatertightRay::new(ray);
     let mut best: Option<Hit> = None;
     for (id, tri) in indices.iter().enumerate() {
@@ -17,11 +28,11 @@ fn brute_force(positions: &[Vec3], indices: &[[u32; 3]], ray: &Ray) -> Option<Hi
             continue;
         }
         let tmax = best.map_or(ray.tmax, |b| b.t);
-        if let Some(h) = intersect_triangle(&wray, tmax, a, b, c) {
-            // Equal t: the lower id wins (ids are visited in increasing order, so keep the first).
-            if best.is_none_or(|b| h.t < b.t) {
-                best = Some(Hit { t: h.t, triangle: id as u32, u: h.u, v: h.v });
-            }
+        if let Some(h) = intersect_triangle(&wray, tmax, a, b, c)
+            && best.is_none_or(|b| h.t < b.t)
+            && keep(id as u32, h.u, h.v)
+        {
+            best = Some(Hit { t: h.t, triangle: id as u32, u: h.u, v: h.v });
         }
     }
     best
@@ -365,4 +376,47 @@ fn negative_zero_directions_enter_boxes() {
             }
         }
     }
+}
+
+/// Cutouts: the filtered queries of every ISA against brute force with the same filter, which
+/// refuses whole triangles (a third of the ids) and parts of others (by barycentrics), so that rays
+/// must go on past refused hits to farther ones. A filter that refuses nothing gives the plain answers.
+#[test]
+fn filtered_queries_match_brute_force_on_every_isa() {
+    let keep = |id: u32, u: f32, v: f32| !id.is_multiple_of(3) && (id.is_multiple_of(2) || u + 0.5 * v < 0.45);
+    let keep_all = |_: u32, _: f32, _: f32| true;
+    let mut rng = TestRng(77);
+    let mut refused_nearer = 0;
+    for mesh_index in 0..60 {
+        let (positions, indices) = random_mesh(&mut rng, 2 + mesh_index % 5);
+        let accels: Vec<Accel> = Isa::supported()
+            .into_iter()
+            .map(|isa| Accel::build(&positions, &indices, BuildPreset::default(), isa))
+            .collect();
+        for i in 0..64 {
+            let origin = rng.vec3(-15.0, 15.0);
+            let target = positions[indices[rng.below(indices.len())][i % 3] as usize];
+            let mut ray =
+                if i % 4 == 3 { Ray::new(origin, rng.direction()) } else { Ray::new(origin, target - origin) };
+            if i % 5 == 0 {
+                ray.tmax = rng.range(0.0, 20.0);
+            }
+            let expected = brute_force_filtered(&positions, &indices, &ray, &keep);
+            let plain = brute_force(&positions, &indices, &ray);
+            refused_nearer += usize::from(plain.is_some() && plain != expected);
+            for accel in &accels {
+                let isa = accel.isa();
+                assert_eq!(accel.intersect_filtered(&ray, &keep), expected, "mesh {mesh_index} {isa} {ray:?}");
+                assert_eq!(
+                    accel.occluded_filtered(&ray, &keep),
+                    expected.is_some(),
+                    "mesh {mesh_index} {isa} occlusion"
+                );
+                assert_eq!(accel.intersect_filtered(&ray, &keep_all), plain, "mesh {mesh_index} {isa} keep all");
+                assert_eq!(accel.occluded_filtered(&ray, &keep_all), plain.is_some(), "mesh {mesh_index} {isa}");
+            }
+        }
+    }
+    // The filter must matter: many rays have their nearest hit refused.
+    assert!(refused_nearer > 300, "only {refused_nearer} rays had a refused hit");
 }

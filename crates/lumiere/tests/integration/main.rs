@@ -5,6 +5,7 @@ mod common;
 mod bsdfs;
 mod bvh;
 mod camera;
+mod cutouts;
 mod estimators;
 mod film;
 mod hostile_inputs;

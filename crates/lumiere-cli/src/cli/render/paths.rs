@@ -76,7 +76,7 @@ pub fn check(args: &RenderArgs) -> Result<()> {
 /// Refuses an output that is one of the files the loaded scene was read from: its material
 /// libraries and textures.
 pub fn check_against_sources(args: &RenderArgs, scene: &Scene) -> Result<()> {
-    let textures = scene.materials.iter().filter_map(|m| m.map_kd.as_deref());
+    let textures = scene.materials.iter().flat_map(|m| [m.map_kd.as_deref(), m.map_d.as_deref()]).flatten();
     let sources: Vec<&Path> = scene.sources.iter().map(PathBuf::as_path).chain(textures).collect();
     let outputs = [Some(&args.output), args.stats_json.as_ref(), args.checkpoint.as_ref()];
     for output in outputs.into_iter().flatten() {

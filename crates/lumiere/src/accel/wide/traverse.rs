@@ -9,7 +9,7 @@ use super::leaf::{self, LEAF_BIT};
 use super::node::WideNode;
 use super::triangles::{TriangleRay, intersect_block};
 use crate::accel::bvh2::MAX_DEPTH;
-use crate::accel::simd::{LaneMask, Lanes};
+use crate::accel::simd::{LaneMask, Lanes, lanes_of};
 use crate::accel::slab::{BOX_EXPANSION, PRUNE_SLACK, safe_reciprocal};
 use crate::accel::{Hit, TraversalStats};
 use crate::math::Ray;
@@ -109,7 +109,17 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         L::dispatch(
             #[inline(always)]
-            || self.intersect_impl::<false>(ray, &mut TraversalStats::default()),
+            || self.intersect_impl::<false>(ray, &mut TraversalStats::default(), |_, _, _| true),
+        )
+    }
+
+    /// As [`WideBvh::intersect`], ignoring the hits `keep(triangle, u, v)` refuses (surfaces cut
+    /// out there): the closest hit that `keep` accepts.
+    #[inline(never)]
+    pub fn intersect_filtered(&self, ray: &Ray, keep: &dyn Fn(u32, f32, f32) -> bool) -> Option<Hit> {
+        L::dispatch(
+            #[inline(always)]
+            || self.intersect_impl::<false>(ray, &mut TraversalStats::default(), keep),
         )
     }
 
@@ -118,7 +128,7 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
     pub fn intersect_counted(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
         L::dispatch(
             #[inline(always)]
-            || self.intersect_impl::<true>(ray, stats),
+            || self.intersect_impl::<true>(ray, stats, |_, _, _| true),
         )
     }
 
@@ -127,7 +137,16 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
     pub fn occluded(&self, ray: &Ray) -> bool {
         L::dispatch(
             #[inline(always)]
-            || self.occluded_impl::<false>(ray, &mut TraversalStats::default()),
+            || self.occluded_impl::<false>(ray, &mut TraversalStats::default(), |_, _, _| true),
+        )
+    }
+
+    /// As [`WideBvh::occluded`], counting only the hits `keep(triangle, u, v)` accepts.
+    #[inline(never)]
+    pub fn occluded_filtered(&self, ray: &Ray, keep: &dyn Fn(u32, f32, f32) -> bool) -> bool {
+        L::dispatch(
+            #[inline(always)]
+            || self.occluded_impl::<false>(ray, &mut TraversalStats::default(), keep),
         )
     }
 
@@ -136,12 +155,17 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
     pub fn occluded_counted(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
         L::dispatch(
             #[inline(always)]
-            || self.occluded_impl::<true>(ray, stats),
+            || self.occluded_impl::<true>(ray, stats, |_, _, _| true),
         )
     }
 
     #[inline(always)]
-    fn intersect_impl<const COUNT: bool>(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
+    fn intersect_impl<const COUNT: bool>(
+        &self,
+        ray: &Ray,
+        stats: &mut TraversalStats,
+        keep: impl Fn(u32, f32, f32) -> bool,
+    ) -> Option<Hit> {
         let box_ray = BoxRay::<L>::new::<W>(ray);
         let tri_ray = TriangleRay::<L>::new::<W>(ray);
         let mut best: Option<Hit> = None;
@@ -161,9 +185,9 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
                         while mask != 0 {
                             let lane = mask.trailing_zeros() as usize;
                             mask &= mask - 1;
-                            let (t, id) = (hits.t[lane], block.ids[lane]);
-                            if best.is_none_or(|b| t < b.t || (t == b.t && id < b.triangle)) {
-                                best = Some(Hit { t, triangle: id, u: hits.u[lane], v: hits.v[lane] });
+                            let (t, id, u, v) = (hits.t[lane], block.ids[lane], hits.u[lane], hits.v[lane]);
+                            if best.is_none_or(|b| t < b.t || (t == b.t && id < b.triangle)) && keep(id, u, v) {
+                                best = Some(Hit { t, triangle: id, u, v });
                                 tmax = t;
                             }
                         }
@@ -188,7 +212,12 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
     }
 
     #[inline(always)]
-    fn occluded_impl<const COUNT: bool>(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
+    fn occluded_impl<const COUNT: bool>(
+        &self,
+        ray: &Ray,
+        stats: &mut TraversalStats,
+        keep: impl Fn(u32, f32, f32) -> bool,
+    ) -> bool {
         let box_ray = BoxRay::<L>::new::<W>(ray);
         let tri_ray = TriangleRay::<L>::new::<W>(ray);
         let tmax = ray.tmax;
@@ -202,7 +231,8 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
                     if COUNT {
                         stats.blocks += 1;
                     }
-                    if intersect_block(&tri_ray, block, tmax).mask != 0 {
+                    let hits = intersect_block(&tri_ray, block, tmax);
+                    if lanes_of(hits.mask).any(|lane| keep(block.ids[lane], hits.u[lane], hits.v[lane])) {
                         return true;
                     }
                 }

@@ -9,7 +9,7 @@ use glam::Vec3;
 use std::path::{Path, PathBuf};
 
 /// Parses the MTL file read from `path` into its materials, in file order, with one warning per
-/// line that was ignored (capped, see [`Warnings`]); `map_Kd` files resolve relative to its folder.
+/// line that was ignored (capped, see [`Warnings`]); `map_Kd` and `map_d` files resolve relative to its folder.
 pub(super) fn parse_mtl(bytes: &[u8], path: &Path, warnings: &mut Warnings) -> Vec<Material> {
     let folder = path.parent().unwrap_or(Path::new(""));
     let mut materials: Vec<Material> = Vec::new();
@@ -66,6 +66,7 @@ enum Statement {
     Dissolve(f32),
     Illumination(u32),
     DiffuseMap(PathBuf),
+    CoverageMap(PathBuf),
     TransmissionFilter(Vec3),
     Metallic(f32),
     Roughness(f32),
@@ -85,6 +86,7 @@ impl Statement {
             Statement::Dissolve(d) => material.dissolve = d,
             Statement::Illumination(illum) => material.illum = illum,
             Statement::DiffuseMap(path) => material.map_kd = Some(path),
+            Statement::CoverageMap(path) => material.map_d = Some(path),
             Statement::TransmissionFilter(tf) => material.tf = tf,
             Statement::Metallic(pm) => material.metallic = Some(pm),
             Statement::Roughness(pr) => material.roughness = Some(pr),
@@ -113,7 +115,8 @@ fn parse_statement(line: &[u8], folder: &Path) -> Result<Option<Statement>, Stri
         b"d" => Statement::Dissolve(scalar(tokens.skip_while(|&token| token == b"-halo"))?),
         b"Tr" => Statement::Dissolve(1.0 - scalar(tokens)?),
         b"illum" => Statement::Illumination(integer(tokens)?),
-        b"map_Kd" => Statement::DiffuseMap(texture_path(tokens, folder)?),
+        b"map_Kd" => Statement::DiffuseMap(texture_path("map_Kd", tokens, folder)?),
+        b"map_d" => Statement::CoverageMap(texture_path("map_d", tokens, folder)?),
         b"Tf" => Statement::TransmissionFilter(color(tokens)?),
         b"Pm" => Statement::Metallic(scalar(tokens)?),
         b"Pr" => Statement::Roughness(scalar(tokens)?),
@@ -161,8 +164,8 @@ fn integer<'a>(mut tokens: impl Iterator<Item = &'a [u8]>) -> Result<u32, String
 
 /// The texture file is the last token: options such as `-bm 1` or `-o 0 0 0` come before it.
 /// Backslashes become slashes, since files exported on Windows use them as separators.
-fn texture_path<'a>(tokens: impl Iterator<Item = &'a [u8]>, folder: &Path) -> Result<PathBuf, String> {
-    let file = tokens.last().ok_or("map_Kd without a file name")?;
+fn texture_path<'a>(keyword: &str, tokens: impl Iterator<Item = &'a [u8]>, folder: &Path) -> Result<PathBuf, String> {
+    let file = tokens.last().ok_or_else(|| format!("{keyword} without a file name"))?;
     let file = String::from_utf8_lossy(file).replace('\\', "/");
     Ok(folder.join(file))
 }
