@@ -354,12 +354,11 @@ impl OriginBatch {
             if crosses == 0 {
                 return false;
             }
-            // t = plane_offset / (d . n), accepted in (0, tmax] without dividing; the normal faces
-            // away from the origin, so the plane is ahead where d . n > 0.
-            let denominator = dot(&block.normal);
-            let ahead = denominator.gt(zero);
-            let within = F32x4::load(&block.plane_offset).le(tmax * denominator);
-            crosses & (ahead.bits() & within.bits()) != 0
+            // t = plane_offset / (d . n), accepted in (0, tmax] without dividing. The normal faces
+            // away from the origin (`plane_offset` > 0, or NaN), so within reach implies ahead:
+            // `0 < plane_offset <= tmax (d . n)` with `tmax > 0` holds only where `d . n > 0`.
+            let within = F32x4::load(&block.plane_offset).le(tmax * dot(&block.normal));
+            crosses & within.bits() != 0
         })
     }
 }
@@ -399,10 +398,9 @@ impl OriginBatch {
                     let (least, most) = (min_ps(min_ps(s0, s1), s2), max_ps(max_ps(s0, s1), s2));
                     blocked[ray] |= if BOUNDED {
                         // The same signs (turning them all changes nothing here), and the plane
-                        // ahead, within reach.
+                        // within reach (which implies ahead: see `occluded`).
                         let crosses = (least < 0.0) ^ (most > 0.0);
-                        let denominator = dot(normal);
-                        crosses & (denominator > 0.0) & (numerator <= tmax * denominator)
+                        crosses & (numerator <= tmax * dot(normal))
                     } else {
                         // Through the triangle, ahead.
                         (least >= 0.0) & (most > 0.0)
