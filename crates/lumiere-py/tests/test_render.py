@@ -108,6 +108,39 @@ def test_scene_from_arrays_and_info():
         lumiere.Scene.from_arrays(np.zeros((4, 2)), [[0, 1, 2]])
 
 
+def grey_png(path, values):
+    """A one-row 8-bit grey PNG of `values`, written without an imaging library."""
+    import struct
+    import zlib
+
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+
+    header = struct.pack(">IIBBBBB", len(values), 1, 8, 0, 0, 0, 0)
+    pixels = zlib.compress(b"\x00" + bytes(values))
+    path.write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", pixels) + chunk(b"IEND", b""))
+
+
+def test_cutouts_show_in_info_and_render_the_cli_bytes(cli, tmp_path):
+    grey_png(tmp_path / "mask.png", [0, 255])
+    obj = tmp_path / "leaf.obj"
+    obj.write_text("mtllib leaf.mtl\nv -1 0 -1\nv 1 0 -1\nv 0 0 1\nv -1 1 -1\nv 1 1 -1\nv 1 1 1\nv -1 1 1\n"
+                   "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl floor\nf 1 3 2\nusemtl leaf\nf 4/1 7/4 6/3\nf 4/1 6/3 5/2\n")
+    (tmp_path / "leaf.mtl").write_text("newmtl floor\nKd 0.5 0.5 0.5\nnewmtl leaf\nKd 0.2 0.6 0.2\nmap_d mask.png\n")
+    scene = lumiere.load(obj)
+    assert scene.info()["materials"]["leaf"]["cutout"] == str(tmp_path / "mask.png")
+    assert scene.info()["materials"]["floor"]["cutout"] is None
+    out = tmp_path / "cli.pfm"
+    cli("render", obj, "--size", "32x24", "--mode", "materials", "--eye", "0,3,2", "--target", "0,0,0", "-o", out)
+    camera = lumiere.Camera.look_at((0, 3, 2), (0, 0, 0), size=(32, 24))
+    image = lumiere.render(scene, camera, mode="materials", spp=1)
+    assert np.array_equal(bits(image), bits(read_pfm(out)))
+    # Half the leaf is cut out: the floor's grey shows where the leaf's green would.
+    pixels = image.reshape(-1, 3)
+    for colour in [(0.2, 0.6, 0.2), (0.5, 0.5, 0.5)]:
+        assert np.isclose(pixels, colour).all(axis=1).any(), colour
+
+
 def test_builtin_info_lists_materials_by_name():
     info = lumiere.builtin().info()
     assert info["triangles"] == 32 and info["lights"]["triangles"] == 2
