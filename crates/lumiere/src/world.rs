@@ -173,8 +173,8 @@ impl World {
     /// triangles, or notes that they are cheaper traced one by one (see [`OriginBatch`]).
     #[inline]
     pub fn prepare_batch(&self, batch: &mut OriginBatch, origin: Vec3, region: &Region, rays: u32) {
-        // A batch's triangles know nothing of cutouts: with them, its rays are traced one by one
-        // (no ray count pays for a gather).
+        // A batch's triangles know nothing of cutouts: with them the batch is readied for no rays,
+        // so it gathers nothing, and the queries below trace its rays one by one, filtered.
         let rays = if self.has_cutouts { 0 } else { rays };
         self.accel.prepare_batch(batch, origin, region, rays);
     }

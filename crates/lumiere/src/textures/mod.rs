@@ -76,18 +76,20 @@ impl Texels {
         }
     }
 
-    /// Texel `i` read as a scalar (a coverage mask without an alpha channel): the luminance of its
-    /// stored values, 8-bit codes over 255 as they are (a mask is not a colour: no sRGB decoding),
-    /// or linear values.
+    /// Texel `i` read as a scalar (a coverage mask without an alpha channel): the luminance of the
+    /// values the file stores, without sRGB decoding (a mask is not a colour). 8-bit codes are
+    /// kept, over 255; 16-bit texels were decoded when loaded, and the encoding curve gives their
+    /// file values back (to within rounding), so that a mask reads the same at either depth.
     #[inline]
     fn scalar(&self, i: usize) -> f32 {
-        match self {
+        let stored = match self {
             Texels::Srgb8 { codes, .. } => {
-                let [r, g, b, _] = codes[i].map(f32::from);
-                (0.2126 * r + 0.7152 * g + 0.0722 * b) / 255.0
+                let [r, g, b, _] = codes[i];
+                Vec3::new(r.into(), g.into(), b.into()) / 255.0
             }
-            Texels::Linear(rgb) => rgb[i].dot(Vec3::new(0.2126, 0.7152, 0.0722)),
-        }
+            Texels::Linear(rgb) => rgb[i].to_array().map(linear_to_srgb).into(),
+        };
+        stored.dot(Vec3::new(0.2126, 0.7152, 0.0722))
     }
 
     fn memory_bytes(&self) -> usize {
@@ -215,8 +217,8 @@ impl Texture {
     }
 
     /// The bilinearly filtered coverage at `uv`, for cutouts (`map_d`): the alpha channel where the
-    /// file has one, otherwise the image read as a scalar (the luminance of its 8-bit codes over
-    /// 255, as a grey mask is drawn), as renderers read a `map_d` file.
+    /// file has one, otherwise the image read as a scalar (the luminance of the grey levels the
+    /// file stores, as a mask is drawn), as renderers read a `map_d` file.
     #[inline]
     pub fn sample_coverage(&self, uv: Vec2) -> f32 {
         if self.alpha.is_some() {
@@ -307,6 +309,13 @@ pub fn srgb_to_linear(c: f32) -> f32 {
     let c = c as f64;
     let linear = if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) };
     linear as f32
+}
+
+/// The sRGB encoding curve, the inverse of [`srgb_to_linear`], for a linear value in `[0, 1]`.
+fn linear_to_srgb(l: f32) -> f32 {
+    let l = l as f64;
+    let encoded = if l <= 0.0031308 { l * 12.92 } else { 1.055 * l.powf(1.0 / 2.4) - 0.055 };
+    encoded as f32
 }
 
 /// The linear values of the 256 8-bit sRGB codes, computed once.

@@ -249,3 +249,35 @@ fn the_staircase_textures_decode() {
     assert_eq!(set.len(), paths.len());
     println!("{} textures, {} MiB as linear f32", set.len(), set.memory_bytes() >> 20);
 }
+
+/// Cutout coverage (`map_d`): the alpha channel where the file has one, otherwise the grey levels
+/// as stored (no sRGB decoding), the same at 8 and 16 bits, and the luminance of a coloured mask.
+#[test]
+fn coverage_is_the_alpha_or_the_stored_grey_at_either_depth() {
+    use image::{ImageBuffer, Luma};
+    let dir = TempDir::new("textures-coverage");
+    let levels = [0u8, 64, 128, 200, 255];
+    let grey8 = dir.path("grey8.png");
+    ImageBuffer::from_fn(5, 1, |x, _| Luma([levels[x as usize]])).save_with_format(&grey8, ImageFormat::Png).unwrap();
+    let grey16 = dir.path("grey16.png");
+    ImageBuffer::from_fn(5, 1, |x, _| Luma([u16::from(levels[x as usize]) * 257]))
+        .save_with_format(&grey16, ImageFormat::Png)
+        .unwrap();
+    let rgba = dir.path("rgba.png");
+    // Black colour, alpha from the levels: only the alpha may count.
+    RgbaImage::from_fn(5, 1, |x, _| Rgba([0, 0, 0, levels[x as usize]]))
+        .save_with_format(&rgba, ImageFormat::Png)
+        .unwrap();
+    for path in [&grey8, &grey16, &rgba] {
+        let texture = load_one(path);
+        for (x, &level) in levels.iter().enumerate() {
+            let coverage = texture.sample_coverage(centre(x as u32, 0, 5, 1));
+            let expected = f32::from(level) / 255.0;
+            assert!((coverage - expected).abs() < 1e-4, "{}: texel {x}: {coverage} vs {expected}", path.display());
+        }
+    }
+    // A coloured mask reads as the Rec. 709 luminance of its codes.
+    let colour = dir.path("colour.png");
+    RgbImage::from_fn(1, 1, |_, _| Rgb([255, 0, 0])).save_with_format(&colour, ImageFormat::Png).unwrap();
+    assert!((load_one(&colour).sample_coverage(Vec2::splat(0.5)) - 0.2126).abs() < 1e-6);
+}
