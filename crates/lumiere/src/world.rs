@@ -26,11 +26,9 @@ pub struct World {
     /// Each material's coverage texture (`map_d`), decoded once: rays pass through its surface
     /// where the coverage is below one half ([`World::opaque_at`]).
     cutout_of_material: Vec<Option<TextureId>>,
+    /// The coverage textures that decoded; without one (most scenes) every query goes straight
+    /// to the BVH, its packets and batches (see [`World::has_cutouts`]).
     cutouts: TextureSet,
-    /// Whether any material has a coverage texture. Without one (most scenes) every query goes
-    /// straight to the BVH, its packets and batches; with one, each ray is traced alone, and each
-    /// hit on a cutout material is tested against its texture.
-    has_cutouts: bool,
     /// What could not be derived (textures that failed to load), for the user to see.
     warnings: Vec<String>,
 }
@@ -55,19 +53,7 @@ impl World {
         let (cutout_of_material, cutouts, cutout_warnings) =
             TextureSet::for_cutouts(scene.materials.iter().map(|m| m.map_d.as_deref()));
         warnings.extend(cutout_warnings);
-        let has_cutouts = cutout_of_material.iter().any(Option::is_some);
-        World {
-            scene,
-            accel,
-            lights,
-            kinds,
-            texture_of_material,
-            textures,
-            cutout_of_material,
-            cutouts,
-            has_cutouts,
-            warnings,
-        }
+        World { scene, accel, lights, kinds, texture_of_material, textures, cutout_of_material, cutouts, warnings }
     }
 
     pub fn scene(&self) -> &Scene {
@@ -122,7 +108,7 @@ impl World {
     /// The closest hit along `ray` within `[0, ray.tmax]`.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        if self.has_cutouts {
+        if self.has_cutouts() {
             return self.accel.intersect_filtered(ray, &|id, u, v| self.opaque_at(id, u, v));
         }
         self.accel.intersect(ray)
@@ -132,7 +118,7 @@ impl World {
     /// where they are coherent (see [`Accel::intersect_packet`]); the same hits.
     #[inline]
     pub fn intersect_packet<const N: usize>(&self, rays: &[Ray; N], live: u32) -> [Option<Hit>; N] {
-        if self.has_cutouts {
+        if self.has_cutouts() {
             return std::array::from_fn(
                 |lane| if live & (1 << lane) != 0 { self.intersect(&rays[lane]) } else { None },
             );
@@ -144,8 +130,8 @@ impl World {
     /// bit `i` set if ray `i` is blocked.
     #[inline]
     pub fn occluded_packet<const N: usize>(&self, rays: &[Ray; N], live: u32) -> u32 {
-        if self.has_cutouts {
-            return lanes_of(live).fold(0, |blocked, lane| blocked | u32::from(self.occluded(&rays[lane])) << lane);
+        if self.has_cutouts() {
+            return self.occluded_one_by_one(live, |lane| rays[lane]);
         }
         self.accel.occluded_packet(rays, live)
     }
@@ -153,10 +139,22 @@ impl World {
     /// Whether anything lies along `ray` within `[0, ray.tmax]`.
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
-        if self.has_cutouts {
+        if self.has_cutouts() {
             return self.accel.occluded_filtered(ray, &|id, u, v| self.opaque_at(id, u, v));
         }
         self.accel.occluded(ray)
+    }
+
+    /// Whether a material has a coverage texture that decoded: then each ray is traced alone, and
+    /// each hit on a cutout material is tested against its texture.
+    #[inline]
+    fn has_cutouts(&self) -> bool {
+        !self.cutouts.is_empty()
+    }
+
+    /// Bit `lane` set for each `live` lane whose ray `ray(lane)` is blocked, traced one by one.
+    fn occluded_one_by_one(&self, live: u32, ray: impl Fn(usize) -> Ray) -> u32 {
+        lanes_of(live).fold(0, |blocked, lane| blocked | u32::from(self.occluded(&ray(lane))) << lane)
     }
 
     /// Whether triangle `id` is there at barycentrics `(u, v)` of its second and third corners:
@@ -175,7 +173,7 @@ impl World {
     pub fn prepare_batch(&self, batch: &mut OriginBatch, origin: Vec3, region: &Region, rays: u32) {
         // A batch's triangles know nothing of cutouts: with them the batch is readied for no rays,
         // so it gathers nothing, and the queries below trace its rays one by one, filtered.
-        let rays = if self.has_cutouts { 0 } else { rays };
+        let rays = if self.has_cutouts() { 0 } else { rays };
         self.accel.prepare_batch(batch, origin, region, rays);
     }
 
@@ -195,9 +193,9 @@ impl World {
         tmax: f32,
         live: u32,
     ) -> u32 {
-        if self.has_cutouts {
-            let ray = |lane: usize| Ray { origin: batch.origin(), dir: Vec3::from(dirs.map(|d| d[lane])), tmax };
-            return lanes_of(live).fold(0, |blocked, lane| blocked | u32::from(self.occluded(&ray(lane))) << lane);
+        if self.has_cutouts() {
+            let origin = batch.origin();
+            return self.occluded_one_by_one(live, |lane| Ray { origin, dir: Vec3::from(dirs.map(|d| d[lane])), tmax });
         }
         self.accel.occluded_lanes_in_batch(batch, dirs, tmax, live)
     }
@@ -205,7 +203,7 @@ impl World {
     /// [`World::occluded`] for a ray of a batch prepared with [`World::prepare_batch`].
     #[inline]
     pub fn occluded_in_batch(&self, batch: &OriginBatch, ray: &Ray) -> bool {
-        if self.has_cutouts {
+        if self.has_cutouts() {
             return self.occluded(ray);
         }
         self.accel.occluded_in_batch(batch, ray)
