@@ -371,12 +371,8 @@ impl OriginBatch {
     pub fn occluded_lanes<const N: usize>(&self, dirs: &[[f32; N]; 3], tmax: f32) -> u32 {
         // Ambient occlusion's rays never end: the edge functions' signs alone say whether a ray
         // passes through a triangle ahead (see `PluckerBlock`), and the plane is not tested.
-        // Shadow segments to light points end at `tmax` 1, where `tmax x` is `x`: one
-        // multiplication fewer per ray and triangle, the same bits.
         if tmax == f32::INFINITY {
             self.occluded_lanes_within::<N, false>(dirs, tmax)
-        } else if tmax == 1.0 {
-            self.occluded_lanes_within::<N, true>(dirs, 1.0)
         } else {
             self.occluded_lanes_within::<N, true>(dirs, tmax)
         }
