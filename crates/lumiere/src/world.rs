@@ -31,6 +31,8 @@ pub struct World {
     cutouts: TextureSet,
     /// What could not be derived (textures that failed to load), for the user to see.
     warnings: Vec<String>,
+    /// The diagonal of the scene's bounding box: no two of its points lie farther apart.
+    diameter: f32,
 }
 
 impl World {
@@ -53,7 +55,19 @@ impl World {
         let (cutout_of_material, cutouts, cutout_warnings) =
             TextureSet::for_cutouts(scene.materials.iter().map(|m| m.map_d.as_deref()));
         warnings.extend(cutout_warnings);
-        World { scene, accel, lights, kinds, texture_of_material, textures, cutout_of_material, cutouts, warnings }
+        let diameter = scene.bounds().extent().length();
+        World {
+            scene,
+            accel,
+            lights,
+            kinds,
+            texture_of_material,
+            textures,
+            cutout_of_material,
+            cutouts,
+            warnings,
+            diameter,
+        }
     }
 
     pub fn scene(&self) -> &Scene {
@@ -66,6 +80,12 @@ impl World {
 
     pub fn lights(&self) -> &LightSet {
         &self.lights
+    }
+
+    /// The diagonal of the scene's bounding box: no ray leaving a point of the scene meets
+    /// anything farther than this.
+    pub fn diameter(&self) -> f32 {
+        self.diameter
     }
 
     /// Problems met while deriving the world (a texture that could not be decoded).

@@ -26,7 +26,7 @@ use glam::{Vec3, Vec4};
 use super::bvh2::MAX_DEPTH;
 use super::simd::{F32x4, LaneMask, Lanes, all_lanes, min_ps};
 use super::wide::{LEAF_BIT, WideBvh, leaf_blocks};
-use crate::math::Ray;
+use crate::math::{Frame, Ray};
 
 /// Beyond this many candidate blocks (of four triangles), per-ray traversal is cheaper.
 const MAX_CANDIDATE_BLOCKS: usize = 24;
@@ -77,6 +77,8 @@ pub struct Region {
     /// on them (the light itself, a coplanar ceiling, the floor under a point) is left out.
     keep_above: [f32; MAX_PLANES],
     count: usize,
+    /// A hemisphere, or a quarter of one: no end, so in a large scene it holds far too much.
+    unbounded: bool,
 }
 
 /// A shaft towards a quad: four sides and the quad's plane.
@@ -100,7 +102,7 @@ impl Region {
         let margin = -tolerance(origin, &corners);
         // The segments end on the triangle `corners` (the light's shadow targets): nothing on or
         // beyond its plane can block them.
-        Some(Region { planes, keep_above: [margin, margin, margin, 0.0, 0.0], count: 4 })
+        Some(Region { planes, keep_above: [margin, margin, margin, 0.0, 0.0], count: 4, unbounded: false })
     }
 
     /// The pyramid spanned by `origin` and the convex quad `corners` (in order around it), cut by
@@ -117,7 +119,7 @@ impl Region {
             *side = plane_facing(origin, corners[k], corners[(k + 1) % 4], centroid)?;
         }
         let margin = -tolerance(origin, &corners);
-        Some(Region { planes, keep_above: [margin, margin, margin, margin, 0.0], count: 5 })
+        Some(Region { planes, keep_above: [margin, margin, margin, margin, 0.0], count: 5, unbounded: false })
     }
 
     /// The half-space above the plane through `origin` with normal `normal`: rays leaving `origin`
@@ -126,12 +128,25 @@ impl Region {
         let n = normal.normalize();
         let mut planes = [Vec4::ZERO; MAX_PLANES];
         planes[0] = n.extend(-n.dot(origin));
-        Region { planes, keep_above: [0.0; MAX_PLANES], count: 1 }
+        Region { planes, keep_above: [0.0; MAX_PLANES], count: 1, unbounded: true }
     }
 
-    /// Whether the region is a whole half-space (a hemisphere of directions), rather than a shaft.
-    fn is_half_space(&self) -> bool {
-        self.count == 1
+    /// Quarter `quarter` (0 to 3) of [`Region::hemisphere`] about `frame.z`: the directions whose
+    /// azimuth lies between `quarter` and `quarter + 1` quarter turns from `frame.x` towards
+    /// `frame.y`. `reach` bounds how far from `origin` anything can be (the scene's size): a
+    /// direction that strays out of the quarter by rounding (its sine or cosine a few ulps below
+    /// zero at a side) still finds every triangle that can block it within that distance, as
+    /// the sides keep what lies a few thousand ulps of `reach` beyond them.
+    pub fn hemisphere_quarter(origin: Vec3, frame: &Frame, quarter: usize, reach: f32) -> Region {
+        let mut region = Region::hemisphere(origin, frame.z);
+        let (x, y) = [(1.0, 1.0), (-1.0, 1.0), (-1.0, -1.0), (1.0, -1.0)][quarter];
+        let margin = -tolerance_within(origin, reach);
+        for (k, side) in [frame.x * x, frame.y * y].into_iter().enumerate() {
+            region.planes[1 + k] = side.extend(-side.dot(origin));
+            region.keep_above[1 + k] = margin;
+        }
+        region.count = 3;
+        region
     }
 
     /// Mask of the block's `W` triangles that do not lie wholly at or below `keep_above` of a plane.
@@ -184,7 +199,11 @@ fn plane_distance<const W: usize, L: Lanes<W>>(plane: &Vec4, points: &[[f32; W];
 /// A few thousand ulps of the coordinates of a shaft from `origin` to `corners`: far above
 /// rounding, far below any geometry.
 fn tolerance(origin: Vec3, corners: &[Vec3]) -> f32 {
-    let size = corners.iter().map(|c| (*c - origin).length()).fold(0.0f32, f32::max);
+    tolerance_within(origin, corners.iter().map(|c| (*c - origin).length()).fold(0.0f32, f32::max))
+}
+
+/// A few thousand ulps of the coordinates of a region reaching `size` from `origin`.
+fn tolerance_within(origin: Vec3, size: f32) -> f32 {
     4096.0 * f32::EPSILON * (origin.abs().max_element() + size)
 }
 
@@ -211,7 +230,7 @@ impl OriginBatch {
     ) {
         self.origin = origin;
         self.blocks.clear();
-        self.traverse = if region.is_half_space() {
+        self.traverse = if region.unbounded {
             rays < MIN_HEMISPHERE_RAYS || bvh.triangle_count() > MAX_HEMISPHERE_SCENE_TRIANGLES
         } else {
             rays < MIN_SHAFT_RAYS

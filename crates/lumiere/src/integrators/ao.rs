@@ -1,3 +1,5 @@
+use std::ops::Range;
+
 use glam::{Vec2, Vec3};
 
 use super::{SampleContext, ShadesClosestHit};
@@ -12,7 +14,10 @@ use crate::world::World;
 /// viewer's side) that reach the sky, or that travel at least `distance` without a hit.
 ///
 /// With directions drawn with pdf `cos(theta)/pi`, the estimator of `(1/pi) * integral of V cos(theta)`
-/// is `(1/N) sum V`: every weight is exactly 1 (GI compendium eq. 35).
+/// is `(1/N) sum V`: every weight is exactly 1 (GI compendium eq. 35). When `samples` is a multiple
+/// of four, the directions are stratified in azimuth: each quarter turn about the normal gets a
+/// quarter of them (the estimator stays unbiased, with less variance), and from
+/// `MIN_QUARTER_BATCH` directions on, each quarter is traced as a batch of its own.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AmbientOcclusion {
     pub samples: u32,
@@ -23,20 +28,42 @@ pub struct AmbientOcclusion {
 /// Probes drawn and tested together: one AVX-512 register of f32 (two AVX2 ones).
 const LANES: usize = 16;
 
+/// From this many probes per point, each quarter of the hemisphere gathers its own candidates: a
+/// quarter of the Cornell box's hemispheres holds 3.2 blocks of four triangles on average against
+/// 7.4 for the whole, so each probe is tested against less than half as many triangles, for four
+/// gatherings instead of one. Measured on the Cornell box (1024x768, alternating, medians of 5):
+/// at 256 probes, 2 threads, 964 -> 836 ms; at 128, quarters from 128 on against from 256 on,
+/// 537 against 526 ms (no gain there).
+const MIN_QUARTER_BATCH: u32 = 256;
+
 impl ShadesClosestHit for AmbientOcclusion {
     fn shade(&self, world: &World, ray: &Ray, hit: Option<Hit>, ctx: &mut SampleContext) -> Vec3 {
         let Some(hit) = hit else { return Vec3::ZERO };
         let surface = world.surface(ray, &hit);
         let frame = Frame::from_normal(surface.ng);
-        let directions = ctx.stream.next_points(self.samples);
-        // All probes leave from one origin into the half-space above the surface: trace them as a batch.
+        let directions = Directions { points: ctx.stream.next_points(self.samples), quarters: self.quarters() };
+        // All probes leave from one origin into the half-space above the surface: trace them as a
+        // batch, or as four, one per quarter of the half-space.
         let origin = surface.offset_origin(surface.ng);
         let mut batch = std::mem::take(&mut ctx.batch);
-        world.prepare_batch(&mut batch, origin, &Region::hemisphere(origin, surface.ng), self.samples);
-        let visible = world.simd(
-            #[inline(always)]
-            || self.count_visible(world, &batch, &frame, &directions, ctx),
-        );
+        let mut visible = 0;
+        if self.samples >= MIN_QUARTER_BATCH && directions.quarters.is_some() {
+            for quarter in 0..4 {
+                let probes = directions.quarter(quarter);
+                let region = Region::hemisphere_quarter(origin, &frame, quarter, world.diameter());
+                world.prepare_batch(&mut batch, origin, &region, probes.len() as u32);
+                visible += world.simd(
+                    #[inline(always)]
+                    || self.count_visible(world, &batch, &frame, &directions, probes, ctx),
+                );
+            }
+        } else {
+            world.prepare_batch(&mut batch, origin, &Region::hemisphere(origin, surface.ng), self.samples);
+            visible = world.simd(
+                #[inline(always)]
+                || self.count_visible(world, &batch, &frame, &directions, 0..self.samples, ctx),
+            );
+        }
         ctx.batch = batch;
         ctx.rays += u64::from(self.samples);
         Vec3::splat(visible as f32 / self.samples as f32)
@@ -44,35 +71,74 @@ impl ShadesClosestHit for AmbientOcclusion {
 }
 
 impl AmbientOcclusion {
-    /// How many of the probes reach the sky, `LANES` at a time: their directions are computed in
-    /// loops over the lanes (vectorised in the world's ISA; each lane does the scalar operations,
-    /// so the bits do not depend on it), then tested together against the batch.
+    /// Where the quarters of the probes start (probes `starts[q]..starts[q + 1]` lie in quarter
+    /// `q`, `starts[4]` being `samples`), when `samples` is a multiple of four.
+    fn quarters(&self) -> Option<[u32; 5]> {
+        let quarter = self.samples / 4;
+        self.samples.is_multiple_of(4).then(|| [0, quarter, 2 * quarter, 3 * quarter, self.samples])
+    }
+
+    /// How many of the probes `probes` reach the sky, `LANES` at a time: their directions are
+    /// computed in loops over the lanes (vectorised in the world's ISA; each lane does the scalar
+    /// operations, so the bits do not depend on it), then tested together against the batch.
     #[inline(always)]
     fn count_visible(
         &self,
         world: &World,
         batch: &OriginBatch,
         frame: &Frame,
-        directions: &PointSet,
+        directions: &Directions<'_>,
+        probes: Range<u32>,
         ctx: &SampleContext,
     ) -> u32 {
         let mut visible = 0;
-        for first in (0..self.samples).step_by(LANES) {
-            // Polled as often as one probe at a time polled it (every `STOP_POLL` probes).
-            if ctx.must_stop(first + LANES as u32 - 1) {
+        for first in probes.clone().step_by(LANES) {
+            // Polled about as often as one probe at a time polled it (every `STOP_POLL` probes).
+            if ctx.must_stop(first / LANES as u32 * LANES as u32 + LANES as u32 - 1) {
                 break;
             }
-            // The random numbers first, then the warp, each in its own vectorisable loop.
-            let points: [Vec2; LANES] = directions.get_2d_lanes(first);
+            let points = directions.points_from(first);
             let mut dirs = [[0.0; LANES]; 3];
             for lane in 0..LANES {
                 let dir = frame.to_world(sample_cosine_hemisphere(points[lane]));
                 [dirs[0][lane], dirs[1][lane], dirs[2][lane]] = dir.to_array();
             }
-            let live = u32::MAX >> (32 - (self.samples - first).min(LANES as u32));
+            let live = u32::MAX >> (32 - (probes.end - first).min(LANES as u32));
             let blocked = world.occluded_lanes_in_batch(batch, &dirs, self.distance, live);
             visible += (live & !blocked).count_ones();
         }
         visible
+    }
+}
+
+/// The random points of a pixel's probes, and where each quarter of them starts when the probes
+/// are stratified in azimuth.
+struct Directions<'a> {
+    points: PointSet<'a>,
+    quarters: Option<[u32; 5]>,
+}
+
+impl Directions<'_> {
+    /// The probes of quarter `quarter`.
+    fn quarter(&self, quarter: usize) -> Range<u32> {
+        let starts = self.quarters.expect("stratified probes");
+        starts[quarter]..starts[quarter + 1]
+    }
+
+    /// The points of probes `first..first + LANES`, each with its azimuth number moved into its
+    /// quarter turn when the probes are stratified: probe `i` of quarter `q` turns by
+    /// `(q + u) / 4` of a turn instead of `u`. The same points whatever range they are drawn for.
+    #[inline(always)]
+    fn points_from(&self, first: u32) -> [Vec2; LANES] {
+        let mut points: [Vec2; LANES] = self.points.get_2d_lanes(first);
+        if let Some(starts) = self.quarters {
+            for (lane, point) in points.iter_mut().enumerate() {
+                let probe = first + lane as u32;
+                let quarter =
+                    u32::from(probe >= starts[1]) + u32::from(probe >= starts[2]) + u32::from(probe >= starts[3]);
+                point.y = (quarter as f32 + point.y) * 0.25;
+            }
+        }
+        points
     }
 }

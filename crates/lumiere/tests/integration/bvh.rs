@@ -6,7 +6,7 @@ use glam::Vec3;
 use lumiere::accel::simd::portable::F32xN;
 use lumiere::accel::{Accel, BuildPreset, Bvh, Bvh4, Hit, Isa, TraversalStats, WideBvh};
 use lumiere::geometry::triangle::{WatertightRay, intersect_triangle, is_degenerate};
-use lumiere::math::Ray;
+use lumiere::math::{Frame, Ray};
 
 fn brute_force(positions: &[Vec3], indices: &[[u32; 3]], ray: &Ray) -> Option<Hit> {
     brute_force_filtered(positions, indices, ray, &|_, _, _| true)
@@ -271,9 +271,15 @@ fn origin_batches_agree_with_traversal() {
             let origin = rng.vec3(-12.0, 12.0);
             let corners = [rng.vec3(-12.0, 12.0), rng.vec3(-12.0, 12.0), rng.vec3(-12.0, 12.0)];
             let normal = rng.direction();
+            let frame = Frame::from_normal(normal);
+            // A shaft, a hemisphere, or a quarter of one (as ambient occlusion traces them).
+            let quarter = (rng.f32() < 0.5).then(|| rng.below(4));
             let (region, shaft) = match Region::shaft(origin, corners) {
                 Some(r) if rng.f32() < 0.5 => (r, true),
-                _ => (Region::hemisphere(origin, normal), false),
+                _ => match quarter {
+                    Some(q) => (Region::hemisphere_quarter(origin, &frame, q, 50.0), false),
+                    None => (Region::hemisphere(origin, normal), false),
+                },
             };
             batch.prepare(&wide, origin, &region, 64);
             batched += usize::from(batch.candidate_blocks().is_some());
@@ -297,7 +303,23 @@ fn origin_batches_agree_with_traversal() {
                     Ray::segment(origin, target)
                 } else {
                     let d = rng.direction();
-                    Ray::new(origin, if d.dot(normal) < 0.0 { -d } else { d })
+                    let d = if d.dot(normal) < 0.0 { -d } else { d };
+                    match quarter {
+                        // Folded into the quarter; some on its sides, or strayed out of it by a
+                        // rounding error, as the sines and cosines of its directions can be.
+                        Some(q) => {
+                            let local = frame.to_local(d);
+                            let signs = [(1.0, 1.0), (-1.0, 1.0), (-1.0, -1.0), (1.0, -1.0)][q];
+                            let (mut x, mut y) = (local.x.abs() * signs.0, local.y.abs() * signs.1);
+                            match k % 8 {
+                                0 => x = 0.0,
+                                1 => y = -1e-7 * signs.1,
+                                _ => {}
+                            }
+                            Ray::new(origin, frame.to_world(Vec3::new(x, y, local.z)))
+                        }
+                        None => Ray::new(origin, d),
+                    }
                 };
                 rays += 1;
                 let occluded = batch.occluded(&wide, &ray);
@@ -342,6 +364,34 @@ fn origin_batches_never_leak_through_a_closed_mesh() {
             if dir.dot(normal) > 0.0 {
                 assert!(batch.occluded(&wide, &Ray::new(origin, dir)), "ray to vertex {p:?} escaped");
             }
+        }
+    }
+}
+
+/// A quarter of a hemisphere whose sides run along the edges of a closed mesh: its directions that
+/// stray out of it by a rounding error (as ambient occlusion's can) still hit the triangles just
+/// beyond its sides, which touch the sides without entering the quarter: the sides keep them.
+#[test]
+fn hemisphere_quarters_keep_what_their_stray_directions_hit() {
+    use lumiere::accel::{OriginBatch, Region};
+    let (positions, indices) = grid_cube(2);
+    let wide = Bvh4::from_binary(&Bvh::build(&positions, &indices, BuildPreset::Default));
+    // About +y, the frame's other axes are x and -z: the sides are the planes x = 0 and z = 0,
+    // which hold edges of the cube's grids.
+    let origin = Vec3::new(0.0, 0.3, 0.0);
+    let frame = Frame::from_normal(Vec3::Y);
+    let mut rng = TestRng(9);
+    let mut batch = OriginBatch::default();
+    for quarter in 0..4 {
+        batch.prepare(&wide, origin, &Region::hemisphere_quarter(origin, &frame, quarter, 4.0), 64);
+        assert!(batch.candidate_blocks().is_some());
+        let (x, y) = [(1.0, 1.0), (-1.0, 1.0), (-1.0, -1.0), (1.0, -1.0)][quarter];
+        for k in 0..256 {
+            let (along, up) = (rng.range(0.0, 1.0), rng.range(0.05, 1.0));
+            let local =
+                if k % 2 == 0 { Vec3::new(-1e-6 * x, along * y, up) } else { Vec3::new(along * x, -1e-6 * y, up) };
+            let ray = Ray::new(origin, frame.to_world(local));
+            assert!(batch.occluded(&wide, &ray), "quarter {quarter}: {ray:?} escaped");
         }
     }
 }
