@@ -25,7 +25,7 @@ use glam::{Vec3, Vec4};
 
 use super::bvh2::MAX_DEPTH;
 use super::simd::{F32x4, LaneMask, Lanes, all_lanes, min_ps};
-use super::wide::{LEAF_BIT, WideBvh, leaf_blocks};
+use super::wide::{LEAF_BIT, TriangleBlock, WideBvh, leaf_blocks};
 use crate::math::{Frame, Ray};
 
 /// Beyond this many candidate blocks (of four triangles), per-ray traversal is cheaper.
@@ -77,9 +77,23 @@ pub struct Region {
     /// on them (the light itself, a coplanar ceiling, the floor under a point) is left out.
     keep_above: [f32; MAX_PLANES],
     count: usize,
-    /// A hemisphere, or a quarter of one: no end, so in a large scene it holds far too much.
+    /// A hemisphere: no end, so in a large scene it holds far too much.
     unbounded: bool,
+    /// Set for a hemisphere split into quarters, each gathered apart (`OriginBatch::select_part`).
+    quarters: Option<Quarters>,
 }
+
+/// The planes through the origin that split a hemisphere into quarters of azimuth, and how far
+/// beyond them a triangle is still kept in a quarter (see [`Region::hemisphere_in_quarters`]).
+#[derive(Clone, Copy, Debug)]
+struct Quarters {
+    x: Vec4,
+    y: Vec4,
+    margin: f32,
+}
+
+/// The parts of a region split into quarters.
+const QUARTERS: usize = 4;
 
 /// A shaft towards a quad: four sides and the quad's plane.
 const MAX_PLANES: usize = 5;
@@ -102,7 +116,13 @@ impl Region {
         let margin = -tolerance(origin, &corners);
         // The segments end on the triangle `corners` (the light's shadow targets): nothing on or
         // beyond its plane can block them.
-        Some(Region { planes, keep_above: [margin, margin, margin, 0.0, 0.0], count: 4, unbounded: false })
+        Some(Region {
+            planes,
+            keep_above: [margin, margin, margin, 0.0, 0.0],
+            count: 4,
+            unbounded: false,
+            quarters: None,
+        })
     }
 
     /// The pyramid spanned by `origin` and the convex quad `corners` (in order around it), cut by
@@ -119,7 +139,13 @@ impl Region {
             *side = plane_facing(origin, corners[k], corners[(k + 1) % 4], centroid)?;
         }
         let margin = -tolerance(origin, &corners);
-        Some(Region { planes, keep_above: [margin, margin, margin, margin, 0.0], count: 5, unbounded: false })
+        Some(Region {
+            planes,
+            keep_above: [margin, margin, margin, margin, 0.0],
+            count: 5,
+            unbounded: false,
+            quarters: None,
+        })
     }
 
     /// The half-space above the plane through `origin` with normal `normal`: rays leaving `origin`
@@ -128,25 +154,25 @@ impl Region {
         let n = normal.normalize();
         let mut planes = [Vec4::ZERO; MAX_PLANES];
         planes[0] = n.extend(-n.dot(origin));
-        Region { planes, keep_above: [0.0; MAX_PLANES], count: 1, unbounded: true }
+        Region { planes, keep_above: [0.0; MAX_PLANES], count: 1, unbounded: true, quarters: None }
     }
 
-    /// Quarter `quarter` (0 to 3) of [`Region::hemisphere`] about `frame.z`: the directions whose
-    /// azimuth lies between `quarter` and `quarter + 1` quarter turns from `frame.x` towards
-    /// `frame.y`. `reach` bounds how far from `origin` anything can be (the scene's size): a
-    /// direction that strays out of the quarter by rounding (its sine or cosine a few ulps below
-    /// zero at a side) still finds every triangle that can block it within that distance, as
-    /// the sides keep what lies a few thousand ulps of `reach` beyond them.
-    pub fn hemisphere_quarter(origin: Vec3, frame: &Frame, quarter: usize, reach: f32) -> Region {
-        let mut region = Region::hemisphere(origin, frame.z);
-        let (x, y) = [(1.0, 1.0), (-1.0, 1.0), (-1.0, -1.0), (1.0, -1.0)][quarter];
-        let margin = -tolerance_within(origin, reach);
-        for (k, side) in [frame.x * x, frame.y * y].into_iter().enumerate() {
-            region.planes[1 + k] = side.extend(-side.dot(origin));
-            region.keep_above[1 + k] = margin;
-        }
-        region.count = 3;
-        region
+    /// [`Region::hemisphere`] about `frame.z`, split into four quarters of azimuth, gathered
+    /// apart in one walk: quarter `q` holds the directions between `q` and `q + 1` quarter turns
+    /// from `frame.x` towards `frame.y`, and the triangles that may block them.
+    ///
+    /// `reach` bounds how far from `origin` anything can be (the scene's size): a direction that
+    /// strays out of its quarter by rounding (its sine or cosine a few ulps below zero at a side)
+    /// still finds every triangle that can block it within that distance, as a quarter keeps what
+    /// lies a few thousand ulps of `reach` beyond its sides.
+    pub fn hemisphere_in_quarters(origin: Vec3, frame: &Frame, reach: f32) -> Region {
+        let through_origin = |n: Vec3| n.extend(-n.dot(origin));
+        let quarters = Quarters {
+            x: through_origin(frame.x),
+            y: through_origin(frame.y),
+            margin: tolerance_within(origin, reach),
+        };
+        Region { quarters: Some(quarters), ..Region::hemisphere(origin, frame.z) }
     }
 
     /// Mask of the block's `W` triangles that do not lie wholly at or below `keep_above` of a plane.
@@ -160,6 +186,20 @@ impl Region {
             kept &= highest.gt(L::splat(keep_above)).bits();
         }
         kept
+    }
+
+    /// Masks of the block's `W` triangles that may reach into each quarter (all of them when the
+    /// region is not split): a triangle is left out of a quarter that lies wholly beyond one of
+    /// its sides, more than the margin away.
+    #[inline(always)]
+    fn quarter_masks<const W: usize, L: Lanes<W>>(&self, vertices: &[[[f32; W]; 3]; 3]) -> [u32; QUARTERS] {
+        let Some(quarters) = &self.quarters else { return [all_lanes(W); QUARTERS] };
+        let (low_x, high_x) = distance_range::<W, L>(&quarters.x, vertices);
+        let (low_y, high_y) = distance_range::<W, L>(&quarters.y, vertices);
+        let (margin, beyond) = (L::splat(quarters.margin), L::splat(-quarters.margin));
+        let (pos_x, neg_x) = (high_x.gt(beyond).bits(), margin.gt(low_x).bits());
+        let (pos_y, neg_y) = (high_y.gt(beyond).bits(), margin.gt(low_y).bits());
+        [pos_x & pos_y, neg_x & pos_y, neg_x & neg_y, pos_x & neg_y]
     }
 
     /// Mask of the node's `W` child boxes that reach above `keep_above` on every plane.
@@ -196,6 +236,18 @@ fn plane_distance<const W: usize, L: Lanes<W>>(plane: &Vec4, points: &[[f32; W];
         + L::splat(plane.w)
 }
 
+/// The lowest and highest signed distances (as [`plane_distance`]) of the corners of `W`
+/// triangles, SoA. A function, not a closure, for the same reason.
+#[inline(always)]
+fn distance_range<const W: usize, L: Lanes<W>>(plane: &Vec4, vertices: &[[[f32; W]; 3]; 3]) -> (L, L) {
+    let (d0, d1, d2) = (
+        plane_distance::<W, L>(plane, &vertices[0]),
+        plane_distance::<W, L>(plane, &vertices[1]),
+        plane_distance::<W, L>(plane, &vertices[2]),
+    );
+    (d0.min(d1).min(d2), d0.max(d1).max(d2))
+}
+
 /// A few thousand ulps of the coordinates of a shaft from `origin` to `corners`: far above
 /// rounding, far below any geometry.
 fn tolerance(origin: Vec3, corners: &[Vec3]) -> f32 {
@@ -212,7 +264,11 @@ fn tolerance_within(origin: Vec3, size: f32) -> f32 {
 #[derive(Clone, Debug, Default)]
 pub struct OriginBatch {
     origin: Vec3,
-    blocks: Vec<PluckerBlock>,
+    /// The candidates of each part of the region, four triangles to a block: one part, or the
+    /// four quarters of a hemisphere split into quarters.
+    parts: [Vec<PluckerBlock>; QUARTERS],
+    /// The part the rays tested next lie in ([`OriginBatch::select_part`]).
+    part: usize,
     traverse: bool,
 }
 
@@ -229,7 +285,8 @@ impl OriginBatch {
         rays: u32,
     ) {
         self.origin = origin;
-        self.blocks.clear();
+        self.parts.iter_mut().for_each(Vec::clear);
+        self.part = 0;
         self.traverse = if region.unbounded {
             rays < MIN_HEMISPHERE_RAYS || bvh.triangle_count() > MAX_HEMISPHERE_SCENE_TRIANGLES
         } else {
@@ -238,17 +295,37 @@ impl OriginBatch {
         if self.traverse || bvh.triangle_count() == 0 {
             return;
         }
-        L::dispatch(
-            #[inline(always)]
-            || self.gather(bvh, region),
-        );
+        if region.quarters.is_some() {
+            L::dispatch(
+                #[inline(always)]
+                || self.gather::<W, L, QUARTERS>(bvh, region),
+            );
+        } else {
+            L::dispatch(
+                #[inline(always)]
+                || self.gather::<W, L, 1>(bvh, region),
+            );
+        }
     }
 
+    /// Makes the rays tested next those of quarter `part` of a region split into quarters (0, the
+    /// default, for any other region). The rays must lie in it.
+    pub fn select_part(&mut self, part: usize) {
+        self.part = part;
+    }
+
+    /// The candidates of the selected part.
     #[inline(always)]
-    fn gather<const W: usize, L: Lanes<W>>(&mut self, bvh: &WideBvh<W, L>, region: &Region) {
-        // Triangles kept but not yet packed into a block of four. (`prepare` gathers only in a
-        // BVH with triangles, so it has a first block.)
-        let mut pending = pending::Pending::new(&bvh.blocks[0]);
+    fn blocks(&self) -> &[PluckerBlock] {
+        &self.parts[self.part]
+    }
+
+    /// Gathers the candidates of the region's `P` parts (1, or its quarters) in one walk.
+    #[inline(always)]
+    fn gather<const W: usize, L: Lanes<W>, const P: usize>(&mut self, bvh: &WideBvh<W, L>, region: &Region) {
+        // Triangles kept but not yet packed into a block of four, per part. (`prepare` gathers
+        // only in a BVH with triangles, so it has a first block.)
+        let mut pending: [_; P] = std::array::from_fn(|_| pending::Pending::new(&bvh.blocks[0]));
         // Depth-first walk of the region; a wide level pushes at most `W` children (one row of the
         // stack per level, as in `wide/traverse.rs`). Left uninitialised, as there: zeroing its
         // 2.3 KB for every origin was a fifth of a soft-shadow render's instructions (callgrind).
@@ -262,37 +339,14 @@ impl OriginBatch {
             let reference = unsafe { stack[len].assume_init() };
             if reference & LEAF_BIT != 0 {
                 for block in &bvh.blocks[leaf_blocks::<W>(reference)] {
-                    let mut kept = region.keeps_triangles::<W, L>(&block.vertices);
-                    // Four kept triangles side by side (padding repeats included: a duplicate never
-                    // changes an any-hit answer) are already four-lane rows: no repacking.
-                    for group in 0..W / 4 {
-                        let lanes = 0xF << (4 * group);
-                        if kept & lanes == lanes {
-                            if self.blocks.len() == MAX_CANDIDATE_BLOCKS {
-                                self.traverse = true;
-                                self.blocks.clear();
-                                return;
-                            }
-                            self.push_corners(pending::group_corners(block, group));
-                            kept &= !lanes;
-                        }
-                    }
-                    while kept != 0 {
-                        let lane = kept.trailing_zeros() as usize;
-                        kept &= kept - 1;
-                        // Padding lanes repeat the block's last triangle: skip the repeats.
-                        if lane > 0 && block.ids[lane] == block.ids[lane - 1] {
-                            continue;
-                        }
-                        if pending.len() == 4 {
-                            self.push_block(&mut pending);
-                        }
-                        if self.blocks.len() == MAX_CANDIDATE_BLOCKS {
+                    let kept = region.keeps_triangles::<W, L>(&block.vertices);
+                    let in_part = region.quarter_masks::<W, L>(&block.vertices);
+                    for (part, pending) in pending.iter_mut().enumerate() {
+                        if !self.keep_in_part(part, block, kept & in_part[part], pending) {
                             self.traverse = true;
-                            self.blocks.clear();
+                            self.parts.iter_mut().for_each(Vec::clear);
                             return;
                         }
-                        pending.push(block, lane);
                     }
                 }
                 continue;
@@ -306,32 +360,76 @@ impl OriginBatch {
                 len += 1;
             }
         }
-        if !pending.is_empty() {
-            self.push_block(&mut pending);
+        for (part, pending) in pending.iter_mut().enumerate() {
+            if !pending.is_empty() {
+                self.push_block(part, pending);
+            }
         }
     }
 
-    /// Appends the Plücker block of the `pending` triangles (emptying it), written in place: a
-    /// block built on the stack and pushed was a `memcpy` call per block (8% of ambient occlusion
-    /// at N = 16).
+    /// Adds the triangles `kept` of `block` to part `part`'s candidates; false if they overflow
+    /// `MAX_CANDIDATE_BLOCKS` blocks.
     #[inline(always)]
-    fn push_block<const W: usize>(&mut self, pending: &mut pending::Pending<W>) {
-        self.push_corners(pending.corners());
+    fn keep_in_part<'a, const W: usize>(
+        &mut self,
+        part: usize,
+        block: &'a TriangleBlock<W>,
+        mut kept: u32,
+        pending: &mut pending::Pending<'a, W>,
+    ) -> bool {
+        // Four kept triangles side by side (padding repeats included: a duplicate never changes
+        // an any-hit answer) are already four-lane rows: no repacking.
+        for group in 0..W / 4 {
+            let lanes = 0xF << (4 * group);
+            if kept & lanes == lanes {
+                if self.parts[part].len() == MAX_CANDIDATE_BLOCKS {
+                    return false;
+                }
+                self.push_corners(part, pending::group_corners(block, group));
+                kept &= !lanes;
+            }
+        }
+        while kept != 0 {
+            let lane = kept.trailing_zeros() as usize;
+            kept &= kept - 1;
+            // Padding lanes repeat the block's last triangle: skip the repeats.
+            if lane > 0 && block.ids[lane] == block.ids[lane - 1] {
+                continue;
+            }
+            if pending.len() == 4 {
+                self.push_block(part, pending);
+            }
+            if self.parts[part].len() == MAX_CANDIDATE_BLOCKS {
+                return false;
+            }
+            pending.push(block, lane);
+        }
+        true
+    }
+
+    /// Appends to part `part` the Plücker block of the `pending` triangles (emptying it), written
+    /// in place: a block built on the stack and pushed was a `memcpy` call per block (8% of
+    /// ambient occlusion at N = 16).
+    #[inline(always)]
+    fn push_block<const W: usize>(&mut self, part: usize, pending: &mut pending::Pending<W>) {
+        self.push_corners(part, pending.corners());
         pending.clear();
     }
 
-    /// Appends the Plücker block of four triangles' corners (`[corner][axis]`, a lane each).
+    /// Appends to part `part` the Plücker block of four triangles' corners (`[corner][axis]`, a
+    /// lane each).
     #[inline(always)]
-    fn push_corners(&mut self, corners: [[F32x4; 3]; 3]) {
-        if self.blocks.len() == self.blocks.capacity() {
-            self.blocks.reserve(MAX_CANDIDATE_BLOCKS);
+    fn push_corners(&mut self, part: usize, corners: [[F32x4; 3]; 3]) {
+        let blocks = &mut self.parts[part];
+        if blocks.len() == blocks.capacity() {
+            blocks.reserve(MAX_CANDIDATE_BLOCKS);
         }
-        let len = self.blocks.len();
+        let len = blocks.len();
         // SAFETY: there is room for one more block (reserved above); `write_plucker_block` writes
         // every field of the slot before the length covers it.
         unsafe {
-            write_plucker_block(self.blocks.as_mut_ptr().add(len), self.origin, corners);
-            self.blocks.set_len(len + 1);
+            write_plucker_block(blocks.as_mut_ptr().add(len), self.origin, corners);
+            blocks.set_len(len + 1);
         }
     }
 
@@ -347,7 +445,7 @@ impl OriginBatch {
 
     /// Candidate blocks gathered, and whether rays fall back to traversal (for tests and tuning).
     pub fn candidate_blocks(&self) -> Option<usize> {
-        (!self.traverse).then_some(self.blocks.len())
+        (!self.traverse).then_some(self.blocks().len())
     }
 
     /// True if the ray (which must leave from the prepared origin, inside the region) is blocked
@@ -362,7 +460,7 @@ impl OriginBatch {
         let zero = F32x4::splat(0.0);
         let tmax = F32x4::splat(ray.tmax);
         let bounded = ray.tmax != f32::INFINITY;
-        self.blocks.iter().any(|block| {
+        self.blocks().iter().any(|block| {
             let dot =
                 |v: &[[f32; 4]; 3]| d[0] * F32x4::load(&v[0]) + d[1] * F32x4::load(&v[1]) + d[2] * F32x4::load(&v[2]);
             let (s0, s1, s2) = (dot(&block.edges[0]), dot(&block.edges[1]), dot(&block.edges[2]));
@@ -402,7 +500,7 @@ impl OriginBatch {
         const { assert!(N <= 32, "a lane mask is a u32") };
         debug_assert!(!self.traverse);
         let mut blocked = [false; N];
-        for block in &self.blocks {
+        for block in self.blocks() {
             for triangle in 0..4 {
                 let vector = |v: &[[f32; 4]; 3]| [v[0][triangle], v[1][triangle], v[2][triangle]];
                 let [e0, e1, e2] = [vector(&block.edges[0]), vector(&block.edges[1]), vector(&block.edges[2])];

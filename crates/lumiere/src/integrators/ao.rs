@@ -28,13 +28,13 @@ pub struct AmbientOcclusion {
 /// Probes drawn and tested together: one AVX-512 register of f32 (two AVX2 ones).
 const LANES: usize = 16;
 
-/// From this many probes per point, each quarter of the hemisphere gathers its own candidates: a
-/// quarter of the Cornell box's hemispheres holds 3.2 blocks of four triangles on average against
-/// 7.4 for the whole, so each probe is tested against less than half as many triangles, for four
-/// gatherings instead of one. Measured on the Cornell box (1024x768, alternating, medians of 5):
-/// at 256 probes, 2 threads, 964 -> 836 ms; at 128, quarters from 128 on against from 256 on,
-/// 537 against 526 ms (no gain there).
-const MIN_QUARTER_BATCH: u32 = 256;
+/// From this many probes per point, each quarter of the hemisphere has candidates of its own,
+/// gathered together in one walk: a quarter of the Cornell box's hemispheres holds 3.2 blocks of
+/// four triangles on average against 7.4 for the whole, so each probe is tested against less than
+/// half as many triangles. Fewer probes do not pay for the quarters' partly filled groups of
+/// `LANES`. Measured on the Cornell box (1024x768, 2 threads, alternating, medians of 5), quarters
+/// from 16 probes on against from 256 on: 128 probes 488 -> 438 ms, 64: 292 -> 298, 16: 139 -> 306.
+const MIN_QUARTER_BATCH: u32 = 128;
 
 impl ShadesClosestHit for AmbientOcclusion {
     fn shade(&self, world: &World, ray: &Ray, hit: Option<Hit>, ctx: &mut SampleContext) -> Vec3 {
@@ -43,15 +43,16 @@ impl ShadesClosestHit for AmbientOcclusion {
         let frame = Frame::from_normal(surface.ng);
         let directions = Directions { points: ctx.stream.next_points(self.samples), quarters: self.quarters() };
         // All probes leave from one origin into the half-space above the surface: trace them as a
-        // batch, or as four, one per quarter of the half-space.
+        // batch, or as four, one per quarter of the half-space, gathered together.
         let origin = surface.offset_origin(surface.ng);
         let mut batch = std::mem::take(&mut ctx.batch);
         let mut visible = 0;
         if self.samples >= MIN_QUARTER_BATCH && directions.quarters.is_some() {
+            let region = Region::hemisphere_in_quarters(origin, &frame, world.diameter());
+            world.prepare_batch(&mut batch, origin, &region, self.samples);
             for quarter in 0..4 {
+                batch.select_part(quarter);
                 let probes = directions.quarter(quarter);
-                let region = Region::hemisphere_quarter(origin, &frame, quarter, world.diameter());
-                world.prepare_batch(&mut batch, origin, &region, probes.len() as u32);
                 visible += world.simd(
                     #[inline(always)]
                     || self.count_visible(world, &batch, &frame, &directions, probes, ctx),

@@ -272,23 +272,28 @@ fn origin_batches_agree_with_traversal() {
             let corners = [rng.vec3(-12.0, 12.0), rng.vec3(-12.0, 12.0), rng.vec3(-12.0, 12.0)];
             let normal = rng.direction();
             let frame = Frame::from_normal(normal);
-            // A shaft, a hemisphere, or a quarter of one (as ambient occlusion traces them).
+            // A shaft, a hemisphere, or one quarter of a hemisphere split in quarters (as ambient
+            // occlusion traces them).
             let quarter = (rng.f32() < 0.5).then(|| rng.below(4));
             let (region, shaft) = match Region::shaft(origin, corners) {
                 Some(r) if rng.f32() < 0.5 => (r, true),
                 _ => match quarter {
-                    Some(q) => (Region::hemisphere_quarter(origin, &frame, q, 50.0), false),
+                    Some(_) => (Region::hemisphere_in_quarters(origin, &frame, 50.0), false),
                     None => (Region::hemisphere(origin, normal), false),
                 },
             };
+            let part = if shaft { 0 } else { quarter.unwrap_or(0) };
             batch.prepare(&wide, origin, &region, 64);
+            batch.select_part(part);
             batched += usize::from(batch.candidate_blocks().is_some());
             // The candidates are the triangles that survive culling, packed as the tree's leaf
             // blocks allow (four kept side by side go in as they are): every walk of a tree of one
             // width gathers as many blocks, whatever its kernel.
             batch8.prepare(&wide8, origin, &region, 64);
+            batch8.select_part(part);
             for (accel, accel_batch) in &mut accels {
                 accel.prepare_batch(accel_batch, origin, &region, 64);
+                accel_batch.select_part(part);
                 let same_width = if accel.isa().width() == 4 { &batch } else { &batch8 };
                 assert_eq!(accel_batch.candidate_blocks(), same_width.candidate_blocks(), "mesh {mesh_index}");
             }
@@ -382,8 +387,9 @@ fn hemisphere_quarters_keep_what_their_stray_directions_hit() {
     let frame = Frame::from_normal(Vec3::Y);
     let mut rng = TestRng(9);
     let mut batch = OriginBatch::default();
+    batch.prepare(&wide, origin, &Region::hemisphere_in_quarters(origin, &frame, 4.0), 64);
     for quarter in 0..4 {
-        batch.prepare(&wide, origin, &Region::hemisphere_quarter(origin, &frame, quarter, 4.0), 64);
+        batch.select_part(quarter);
         assert!(batch.candidate_blocks().is_some());
         let (x, y) = [(1.0, 1.0), (-1.0, 1.0), (-1.0, -1.0), (1.0, -1.0)][quarter];
         for k in 0..256 {
