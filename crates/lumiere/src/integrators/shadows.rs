@@ -6,7 +6,7 @@ use crate::accel::simd::lanes_of;
 use crate::geometry::surface::SurfacePoint;
 use crate::lights::AreaLight;
 use crate::materials::{Bsdf, MaterialBsdf};
-use crate::math::{Frame, Ray};
+use crate::math::{Frame, Ray, offset_ray_origin};
 use crate::world::World;
 
 /// The lab's hard shadows: every light triangle acts as a point light at its centroid carrying the
@@ -38,6 +38,9 @@ impl Integrator for Shadows {
     /// The camera rays of the block as a packet, then for each light the block's shadow rays
     /// towards its centroid as a packet: they share an end point, so they are as coherent as the
     /// camera rays. Each lane adds its lights in the same order as `radiance`: the same bits.
+    ///
+    /// Diffuse receivers (all of the lab's) are lit together, SoA ([`DiffuseLanes`]); any other
+    /// is lit one at a time by its [`Receiver`].
     fn radiance_packet<'a>(
         &self,
         world: &World,
@@ -47,19 +50,28 @@ impl Integrator for Shadows {
         let hits = world.intersect_packet(&camera.rays, camera.live);
         ctx.rays += u64::from(camera.live.count_ones());
         let mut radiance = [Vec3::ZERO; PACKET];
-        let mut receivers: [Option<Receiver>; PACKET] = [None; PACKET];
+        let mut diffuse = DiffuseLanes::default();
+        let mut others: [Option<Receiver>; PACKET] = [None; PACKET];
         for lane in camera.lanes() {
-            match Receiver::new(world, &camera.rays[lane], hits[lane]) {
-                Ok(receiver) => receivers[lane] = Some(receiver),
-                Err(value) => radiance[lane] = value,
+            let ray = &camera.rays[lane];
+            let Some(hit) = hits[lane] else { continue };
+            let emitted = world.emitted(hit.triangle, ray);
+            if emitted != Vec3::ZERO {
+                radiance[lane] = emitted;
+                continue;
+            }
+            let receiver = Receiver::at(world, ray, world.surface(ray, &hit));
+            match receiver.lambertian {
+                Some(f) => diffuse.set(lane, &receiver.surface, f),
+                None => others[lane] = Some(receiver),
             }
         }
         let mut segments = camera.rays;
         let mut contributions = [Vec3::ZERO; PACKET];
         for light in world.lights().lights() {
             let point = LightPoint::of(light);
-            let mut traced = 0u32;
-            for (lane, receiver) in receivers.iter().enumerate() {
+            let mut traced = diffuse.unshadowed(light, &point, &mut segments, &mut contributions);
+            for (lane, receiver) in others.iter().enumerate() {
                 if let Some((segment, contribution)) = receiver.as_ref().and_then(|r| r.unshadowed(light, &point)) {
                     (segments[lane], contributions[lane]) = (segment, contribution);
                     traced |= 1 << lane;
@@ -75,6 +87,94 @@ impl Integrator for Shadows {
             }
         }
         radiance
+    }
+}
+
+/// The diffuse receivers of a packet, SoA: what lighting them needs, and nothing else (copying
+/// whole receivers into an array was a twentieth of the render).
+#[derive(Default)]
+struct DiffuseLanes {
+    /// Bit `i` set if lane `i` holds a diffuse receiver.
+    live: u32,
+    p: [[f32; PACKET]; 3],
+    ns: [[f32; PACKET]; 3],
+    ng: [[f32; PACKET]; 3],
+    /// The BSDF's constant value.
+    f: [[f32; PACKET]; 3],
+    /// The surface point moved off the surface to the side of `ng`, where every shadow ray of a
+    /// diffuse receiver leaves (`unshadowed` wants `wi` above `ng`): computed once, not per light.
+    origin: [[f32; PACKET]; 3],
+}
+
+impl DiffuseLanes {
+    fn set(&mut self, lane: usize, surface: &SurfacePoint, f: Vec3) {
+        self.live |= 1 << lane;
+        let origin = offset_ray_origin(surface.p, surface.ng);
+        for (rows, value) in [
+            (&mut self.p, surface.p),
+            (&mut self.ns, surface.ns),
+            (&mut self.ng, surface.ng),
+            (&mut self.f, f),
+            (&mut self.origin, origin),
+        ] {
+            [rows[0][lane], rows[1][lane], rows[2][lane]] = value.to_array();
+        }
+    }
+
+    /// [`Receiver::unshadowed`] for every diffuse lane: writes the shadow segments and
+    /// contributions of the lanes the light can reach into `segments` and `contributions`, and
+    /// returns those lanes. Each lane does `unshadowed`'s operations in its order (glam's `dot`
+    /// and `length_squared` sum x, y, then z), so the bits are its.
+    #[inline]
+    fn unshadowed(
+        &self,
+        light: &AreaLight,
+        point: &LightPoint,
+        segments: &mut [Ray; PACKET],
+        contributions: &mut [Vec3; PACKET],
+    ) -> u32 {
+        if self.live == 0 {
+            return 0;
+        }
+        let (c, n) = (point.centroid.to_array(), light.normal.to_array());
+        let (target, emission) = (point.target.to_array(), light.emission.to_array());
+        let mut weight = [0.0f32; PACKET];
+        let mut reaches = [false; PACKET];
+        let mut above_ng = [false; PACKET];
+        for lane in 0..PACKET {
+            let v = [0, 1, 2].map(|k| c[k] - self.p[k][lane]);
+            let d2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+            let length = d2.sqrt();
+            let wi = v.map(|x| x / length);
+            let dot = |rows: &[[f32; PACKET]; 3]| rows[0][lane] * wi[0] + rows[1][lane] * wi[1] + rows[2][lane] * wi[2];
+            let cos_surface = dot(&self.ns);
+            let cos_light = n[0] * -wi[0] + n[1] * -wi[1] + n[2] * -wi[2];
+            reaches[lane] = !(cos_surface <= 0.0 || cos_light <= 0.0 || dot(&self.ng) <= 0.0);
+            weight[lane] = cos_surface * cos_light * light.area / d2;
+            // `spawn_segment`'s side: the target above `ng` (almost always, once `wi` is).
+            let to_target = [0, 1, 2].map(|k| target[k] - self.p[k][lane]);
+            above_ng[lane] =
+                self.ng[0][lane] * to_target[0] + self.ng[1][lane] * to_target[1] + self.ng[2][lane] * to_target[2]
+                    >= 0.0;
+        }
+        let mut traced = 0;
+        for lane in lanes_of(self.live) {
+            if !reaches[lane] {
+                continue;
+            }
+            traced |= 1 << lane;
+            let f = Vec3::new(self.f[0][lane], self.f[1][lane], self.f[2][lane]);
+            contributions[lane] = f * Vec3::from_array(emission) * weight[lane];
+            let p = Vec3::new(self.p[0][lane], self.p[1][lane], self.p[2][lane]);
+            let ng = Vec3::new(self.ng[0][lane], self.ng[1][lane], self.ng[2][lane]);
+            let origin = if above_ng[lane] {
+                Vec3::new(self.origin[0][lane], self.origin[1][lane], self.origin[2][lane])
+            } else {
+                offset_ray_origin(p, -ng)
+            };
+            segments[lane] = Ray::segment(origin, point.target);
+        }
+        traced
     }
 }
 
@@ -114,10 +214,15 @@ impl Receiver {
         if emitted != Vec3::ZERO {
             return Err(emitted);
         }
-        let surface = world.surface(ray, &hit);
+        Ok(Receiver::at(world, ray, world.surface(ray, &hit)))
+    }
+
+    /// The receiver at `surface`, seen along `ray`.
+    #[inline]
+    fn at(world: &World, ray: &Ray, surface: SurfacePoint) -> Receiver {
         let bsdf = world.bsdf(&surface);
         let (frame, wo) = shading_frame(surface.ns, ray);
-        Ok(Receiver { surface, bsdf, lambertian: bsdf.lambertian_eval(wo), frame, wo })
+        Receiver { surface, bsdf, lambertian: bsdf.lambertian_eval(wo), frame, wo }
     }
 
     /// The shadow ray towards `light`'s centroid and the light it brings if nothing blocks it, or

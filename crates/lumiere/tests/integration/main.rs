@@ -12,6 +12,7 @@ mod hostile_inputs;
 mod image_io;
 mod module_graph;
 mod obj_loading;
+mod packets;
 mod path;
 mod quad_lights;
 mod range;

@@ -1,0 +1,56 @@
+//! Camera rays shaded as packets give each pixel the bits its single ray gives.
+
+use lumiere::accel::OriginBatch;
+use lumiere::integrators::{CameraPacket, Integrator, PACKET, SampleContext, Shadows};
+use lumiere::materials::MaterialKind;
+use lumiere::sampler::{SampleStream, Sampler, SamplerKind};
+use lumiere::scene::camera::Camera;
+use lumiere::scene::{Scene, builtin};
+use lumiere::world::World;
+
+/// Hard shadows light a packet's diffuse receivers together (SoA) and the others one at a time:
+/// on the built-in box with every other material made glossy, so that packets mix the two, each
+/// lane of each 4x4 block has the bits of `radiance` for its ray.
+#[test]
+fn hard_shadow_packets_shade_mixed_materials_as_single_rays_do() {
+    let mut scene = Scene::builtin().unwrap();
+    for material in scene.materials.iter_mut().step_by(2) {
+        material.illum = 2;
+        material.ns = 20.0;
+    }
+    assert!(scene.materials.iter().any(|m| matches!(m.kind(), MaterialKind::Plastic { .. })));
+    assert!(scene.materials.iter().any(|m| m.kind() == MaterialKind::Lambert));
+    let world = World::new(scene, Default::default());
+    let (width, height) = (64u32, 48u32);
+    let camera = Camera::from_orbiter(&builtin::cornell_orbiter().unwrap(), width, height);
+    let sampler = Sampler::new(SamplerKind::Independent, 1);
+    let stop = || false;
+    let mut ctx = SampleContext {
+        stream: SampleStream::new(&sampler, 0, 0),
+        batch: OriginBatch::default(),
+        rays: 0,
+        stop: &stop,
+    };
+    let (mut lit, mut compared) = (0, 0);
+    for by in (0..height).step_by(4) {
+        for bx in (0..width).step_by(4) {
+            let xs: [f32; PACKET] = std::array::from_fn(|lane| (bx + lane as u32 % 4) as f32 + 0.5);
+            let ys: [f32; PACKET] = std::array::from_fn(|lane| (by + lane as u32 / 4) as f32 + 0.5);
+            let rays = camera.rays(&xs, &ys);
+            let streams = std::array::from_fn(|lane| SampleStream::new(&sampler, lane as u32, 0));
+            let packet = CameraPacket { rays, streams, live: u32::MAX >> (32 - PACKET) };
+            let together = Shadows.radiance_packet(&world, &packet, &mut ctx);
+            for lane in 0..PACKET {
+                let alone = Shadows.radiance(&world, &rays[lane], &mut ctx);
+                assert_eq!(
+                    together[lane].to_array().map(f32::to_bits),
+                    alone.to_array().map(f32::to_bits),
+                    "block ({bx}, {by}) lane {lane}"
+                );
+                lit += usize::from(alone.max_element() > 0.0);
+                compared += 1;
+            }
+        }
+    }
+    assert!(lit * 2 > compared, "{lit} of {compared} pixels lit");
+}
