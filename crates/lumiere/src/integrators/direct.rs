@@ -57,9 +57,15 @@ const LANES: usize = 16;
 
 impl<B: Bsdf> Receiver<'_, B> {
     /// `sum` plus `f Le V cos(theta) / pdf` of each of the `n` points of `light` drawn from
-    /// `points`, `LANES` at a time: their contributions are computed lane by lane, their shadow
-    /// segments tested together against the batch (prepared for the shaft to the light), and the
-    /// visible ones added to `sum` in sample order, so it has the bits of one sample at a time.
+    /// `points`, `LANES` at a time: their contributions are computed lane by lane and their shadow
+    /// segments tested together against the batch (prepared for the shaft to the light).
+    ///
+    /// A diffuse receiver's contributions are `f Le` times a weight `cos(theta) / pdf`: the
+    /// visible weights are added up lane by lane (sample `k` into lane `k % LANES`, in sample
+    /// order), the lanes then in lane order, and `f Le` times that total is added to `sum`, the
+    /// same additions on every ISA. (Adding each visible contribution to `sum` in sample order, a
+    /// chain of dependent scalar additions, was a tenth of a soft-shadow render.) Other receivers
+    /// add their visible contributions to `sum` in sample order.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     fn add_light(
@@ -79,6 +85,7 @@ impl<B: Bsdf> Receiver<'_, B> {
             // A zero BSDF: `unshadowed` refuses every sample, no ray is traced.
             return sum;
         }
+        let mut lane_weights = [0.0f32; LANES];
         for first in (0..n).step_by(LANES) {
             // Polled as often as one sample at a time polled it (every `STOP_POLL` samples).
             if ctx.must_stop(first + LANES as u32 - 1) {
@@ -86,17 +93,33 @@ impl<B: Bsdf> Receiver<'_, B> {
             }
             let count = (n - first).min(LANES as u32) as usize;
             let points: [Vec2; LANES] = points.get_2d_lanes(first);
-            let (contributions, segments, traced) = match lambertian {
-                Some(f) => self.lambertian_lanes(f, &lights.lights()[light as usize], &points, count, origin),
-                None => self.bsdf_lanes(lights, light, &points, count, origin),
-            };
-            ctx.rays += u64::from(traced.count_ones());
-            let visible = traced & !world.occluded_lanes_in_batch(batch, &segments, 1.0, traced);
-            for lane in lanes_of(visible) {
-                sum += contributions[lane];
+            if lambertian.is_some() {
+                let (weights, segments, traced) =
+                    self.lambertian_lanes(&lights.lights()[light as usize], &points, count, origin);
+                ctx.rays += u64::from(traced.count_ones());
+                let visible = traced & !world.occluded_lanes_in_batch(batch, &segments, 1.0, traced);
+                // All ones for a visible lane, else zero: the weights are masked bitwise (an
+                // unlit lane's may be infinite or NaN, which a product by 0 would keep).
+                for lane in 0..LANES {
+                    let keep = 0u32.wrapping_sub((visible >> lane) & 1);
+                    lane_weights[lane] += f32::from_bits(weights[lane].to_bits() & keep);
+                }
+            } else {
+                let (contributions, segments, traced) = self.bsdf_lanes(lights, light, &points, count, origin);
+                ctx.rays += u64::from(traced.count_ones());
+                let visible = traced & !world.occluded_lanes_in_batch(batch, &segments, 1.0, traced);
+                for lane in lanes_of(visible) {
+                    sum += contributions[lane];
+                }
             }
         }
-        sum
+        match lambertian {
+            Some(f) => {
+                let total = lane_weights.iter().fold(0.0, |total, &weight| total + weight);
+                sum + f * lights.lights()[light as usize].emission * total
+            }
+            None => sum,
+        }
     }
 }
 
@@ -133,24 +156,22 @@ impl<B: Bsdf> Receiver<'_, B> {
     }
 
     /// [`Receiver::bsdf_lanes`] for a diffuse receiver, whose BSDF is `f` wherever `wi` is above
-    /// its shading normal: everything in one loop over the lanes, SoA, which the ISA vectorises
-    /// whole. Each lane does the operations of `sample_uniform_triangle`, `shadow_target`,
-    /// `sample_li_on`, `faces` and `unshadowed` in their order (glam's `dot` and
-    /// `length_squared` sum x, y, then z), so the bits are theirs (the golden images check it).
+    /// its shading normal, so that a contribution is `f Le` times a weight `cos(theta) / pdf`:
+    /// the weights, shadow segments and traced lanes, in one loop over the lanes, SoA, which the
+    /// ISA vectorises whole. Each lane does the operations of `sample_uniform_triangle`,
+    /// `shadow_target`, `sample_li_on`, `faces` and `unshadowed` in their order (glam's `dot` and
+    /// `length_squared` sum x, y, then z), so its segment and weight have their bits.
     #[inline(always)]
     fn lambertian_lanes(
         &self,
-        f: Vec3,
         light: &AreaLight,
         points: &[Vec2; LANES],
         count: usize,
         origin: Vec3,
-    ) -> ([Vec3; LANES], [[f32; LANES]; 3], u32) {
+    ) -> ([f32; LANES], [[f32; LANES]; 3], u32) {
         let [p0, p1, p2] = light.shadow_targets.map(|t| t.to_array());
         let (p, o) = (self.surface.p.to_array(), origin.to_array());
         let (ns, ng, normal) = (self.surface.ns, self.surface.ng, light.normal);
-        // `f * li * (cos / pdf)` multiplies `f * li` first.
-        let scale = (f * light.emission).to_array();
         let mut weights = [0.0f32; LANES];
         let mut segments = [[0.0; LANES]; 3];
         let mut traced = 0u32;
@@ -178,8 +199,7 @@ impl<B: Bsdf> Receiver<'_, B> {
             }
             traced |= u32::from(lit) << lane;
         }
-        let contributions = weights.map(|w| Vec3::from_array(scale.map(|k| k * w)));
-        (contributions, segments, traced)
+        (weights, segments, traced)
     }
 }
 
