@@ -10,6 +10,10 @@
 //! SSE operation; `occluded_lanes` (what the integrators use) tests each triangle against up to 32
 //! rays at once, ray-major, with the same operations, so both give the same answers.
 //!
+//! A half-space can also be split into four quarters of azimuth, gathered in the same walk, each
+//! with the triangles that may block its own rays (about half of the whole's): ambient occlusion
+//! with many rays per point traces them quarter by quarter (`OriginBatch::select_part`).
+//!
 //! The walk is generic in the BVH's width and kernel; the candidates go four to a Plücker block
 //! whatever that width: four kept side by side in a leaf block as they lie, the others repacked.
 //!
@@ -310,7 +314,11 @@ impl OriginBatch {
 
     /// Makes the rays tested next those of quarter `part` of a region split into quarters (0, the
     /// default, for any other region). The rays must lie in it.
+    ///
+    /// # Panics
+    /// If `part` is not below 4.
     pub fn select_part(&mut self, part: usize) {
+        assert!(part < QUARTERS, "a region has at most {QUARTERS} parts, not {}", part + 1);
         self.part = part;
     }
 

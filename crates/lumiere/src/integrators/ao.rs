@@ -47,12 +47,12 @@ impl ShadesClosestHit for AmbientOcclusion {
         let origin = surface.offset_origin(surface.ng);
         let mut batch = std::mem::take(&mut ctx.batch);
         let mut visible = 0;
-        if self.samples >= MIN_QUARTER_BATCH && directions.quarters.is_some() {
+        if let Some(starts) = directions.quarters.filter(|_| self.samples >= MIN_QUARTER_BATCH) {
             let region = Region::hemisphere_in_quarters(origin, &frame, world.diameter());
             world.prepare_batch(&mut batch, origin, &region, self.samples);
             for quarter in 0..4 {
                 batch.select_part(quarter);
-                let probes = directions.quarter(quarter);
+                let probes = starts[quarter]..starts[quarter + 1];
                 visible += world.simd(
                     #[inline(always)]
                     || self.count_visible(world, &batch, &frame, &directions, probes, ctx),
@@ -120,12 +120,6 @@ struct Directions<'a> {
 }
 
 impl Directions<'_> {
-    /// The probes of quarter `quarter`.
-    fn quarter(&self, quarter: usize) -> Range<u32> {
-        let starts = self.quarters.expect("stratified probes");
-        starts[quarter]..starts[quarter + 1]
-    }
-
     /// The points of probes `first..first + LANES`, each with its azimuth number moved into its
     /// quarter turn when the probes are stratified: probe `i` of quarter `q` turns by
     /// `(q + u) / 4` of a turn instead of `u`. The same points whatever range they are drawn for.
@@ -134,7 +128,7 @@ impl Directions<'_> {
         let mut points: [Vec2; LANES] = self.points.get_2d_lanes(first);
         if let Some(starts) = self.quarters {
             for (lane, point) in points.iter_mut().enumerate() {
-                let probe = first + lane as u32;
+                let probe = first.wrapping_add(lane as u32);
                 let quarter =
                     u32::from(probe >= starts[1]) + u32::from(probe >= starts[2]) + u32::from(probe >= starts[3]);
                 point.y = (quarter as f32 + point.y) * 0.25;

@@ -53,17 +53,10 @@ impl Integrator for Shadows {
         let mut diffuse = DiffuseLanes::default();
         let mut others: [Option<Receiver>; PACKET] = [None; PACKET];
         for lane in camera.lanes() {
-            let ray = &camera.rays[lane];
-            let Some(hit) = hits[lane] else { continue };
-            let emitted = world.emitted(hit.triangle, ray);
-            if emitted != Vec3::ZERO {
-                radiance[lane] = emitted;
-                continue;
-            }
-            let receiver = Receiver::at(world, ray, world.surface(ray, &hit));
-            match receiver.lambertian {
-                Some(f) => diffuse.set(lane, &receiver.surface, f),
-                None => others[lane] = Some(receiver),
+            match Receiver::new(world, &camera.rays[lane], hits[lane]) {
+                Ok(Receiver { surface, lambertian: Some(f), .. }) => diffuse.set(lane, &surface, f),
+                Ok(receiver) => others[lane] = Some(receiver),
+                Err(value) => radiance[lane] = value,
             }
         }
         let mut segments = camera.rays;
@@ -214,15 +207,10 @@ impl Receiver {
         if emitted != Vec3::ZERO {
             return Err(emitted);
         }
-        Ok(Receiver::at(world, ray, world.surface(ray, &hit)))
-    }
-
-    /// The receiver at `surface`, seen along `ray`.
-    #[inline]
-    fn at(world: &World, ray: &Ray, surface: SurfacePoint) -> Receiver {
+        let surface = world.surface(ray, &hit);
         let bsdf = world.bsdf(&surface);
         let (frame, wo) = shading_frame(surface.ns, ray);
-        Receiver { surface, bsdf, lambertian: bsdf.lambertian_eval(wo), frame, wo }
+        Ok(Receiver { surface, bsdf, lambertian: bsdf.lambertian_eval(wo), frame, wo })
     }
 
     /// The shadow ray towards `light`'s centroid and the light it brings if nothing blocks it, or
