@@ -114,7 +114,8 @@ pub enum ModeArg {
     Shadows,
     /// Soft shadows: direct light integrated over the area lights with --samples points.
     Direct,
-    /// Ambient occlusion: fraction of --samples cosine-weighted directions that see the sky.
+    /// Ambient occlusion: fraction of --samples cosine-weighted directions that see the sky (a
+    /// multiple of 4 is stratified: a quarter of them in each quarter turn about the normal).
     Ao,
     /// Global illumination: path tracing with next-event estimation and MIS (see --max-depth).
     Path,
