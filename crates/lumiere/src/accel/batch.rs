@@ -81,8 +81,6 @@ pub struct Region {
     /// on them (the light itself, a coplanar ceiling, the floor under a point) is left out.
     keep_above: [f32; MAX_PLANES],
     count: usize,
-    /// A hemisphere: no end, so in a large scene it holds far too much.
-    unbounded: bool,
     /// Set for a hemisphere split into quarters, each gathered apart (`OriginBatch::select_part`).
     quarters: Option<Quarters>,
 }
@@ -120,13 +118,7 @@ impl Region {
         let margin = -tolerance(origin, &corners);
         // The segments end on the triangle `corners` (the light's shadow targets): nothing on or
         // beyond its plane can block them.
-        Some(Region {
-            planes,
-            keep_above: [margin, margin, margin, 0.0, 0.0],
-            count: 4,
-            unbounded: false,
-            quarters: None,
-        })
+        Some(Region { planes, keep_above: [margin, margin, margin, 0.0, 0.0], count: 4, quarters: None })
     }
 
     /// The pyramid spanned by `origin` and the convex quad `corners` (in order around it), cut by
@@ -143,13 +135,7 @@ impl Region {
             *side = plane_facing(origin, corners[k], corners[(k + 1) % 4], centroid)?;
         }
         let margin = -tolerance(origin, &corners);
-        Some(Region {
-            planes,
-            keep_above: [margin, margin, margin, margin, 0.0],
-            count: 5,
-            unbounded: false,
-            quarters: None,
-        })
+        Some(Region { planes, keep_above: [margin, margin, margin, margin, 0.0], count: 5, quarters: None })
     }
 
     /// The half-space above the plane through `origin` with normal `normal`: rays leaving `origin`
@@ -158,7 +144,7 @@ impl Region {
         let n = normal.normalize();
         let mut planes = [Vec4::ZERO; MAX_PLANES];
         planes[0] = n.extend(-n.dot(origin));
-        Region { planes, keep_above: [0.0; MAX_PLANES], count: 1, unbounded: true, quarters: None }
+        Region { planes, keep_above: [0.0; MAX_PLANES], count: 1, quarters: None }
     }
 
     /// [`Region::hemisphere`] about `frame.z`, split into four quarters of azimuth, gathered
@@ -177,6 +163,12 @@ impl Region {
             margin: tolerance_within(origin, reach),
         };
         Region { quarters: Some(quarters), ..Region::hemisphere(origin, frame.z) }
+    }
+
+    /// Whether the region is a whole half-space (a hemisphere of directions, split into quarters
+    /// or not), rather than a shaft: it has no end, so in a large scene it holds far too much.
+    fn is_half_space(&self) -> bool {
+        self.count == 1
     }
 
     /// Mask of the block's `W` triangles that do not lie wholly at or below `keep_above` of a plane.
@@ -291,7 +283,7 @@ impl OriginBatch {
         self.origin = origin;
         self.parts.iter_mut().for_each(Vec::clear);
         self.part = 0;
-        self.traverse = if region.unbounded {
+        self.traverse = if region.is_half_space() {
             rays < MIN_HEMISPHERE_RAYS || bvh.triangle_count() > MAX_HEMISPHERE_SCENE_TRIANGLES
         } else {
             rays < MIN_SHAFT_RAYS

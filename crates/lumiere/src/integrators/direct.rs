@@ -85,6 +85,7 @@ impl<B: Bsdf> Receiver<'_, B> {
             // A zero BSDF: `unshadowed` refuses every sample, no ray is traced.
             return sum;
         }
+        let area_light = &lights.lights()[light as usize];
         let mut lane_weights = [0.0f32; LANES];
         for first in (0..n).step_by(LANES) {
             // Polled as often as one sample at a time polled it (every `STOP_POLL` samples).
@@ -94,10 +95,8 @@ impl<B: Bsdf> Receiver<'_, B> {
             let count = (n - first).min(LANES as u32) as usize;
             let points: [Vec2; LANES] = points.get_2d_lanes(first);
             if lambertian.is_some() {
-                let (weights, segments, traced) =
-                    self.lambertian_lanes(&lights.lights()[light as usize], &points, count, origin);
-                ctx.rays += u64::from(traced.count_ones());
-                let visible = traced & !world.occluded_lanes_in_batch(batch, &segments, 1.0, traced);
+                let (weights, segments, traced) = self.lambertian_lanes(area_light, &points, count, origin);
+                let visible = trace(world, batch, &segments, traced, ctx);
                 // All ones for a visible lane, else zero: the weights are masked bitwise (an
                 // unlit lane's may be infinite or NaN, which a product by 0 would keep).
                 for lane in 0..LANES {
@@ -106,9 +105,7 @@ impl<B: Bsdf> Receiver<'_, B> {
                 }
             } else {
                 let (contributions, segments, traced) = self.bsdf_lanes(lights, light, &points, count, origin);
-                ctx.rays += u64::from(traced.count_ones());
-                let visible = traced & !world.occluded_lanes_in_batch(batch, &segments, 1.0, traced);
-                for lane in lanes_of(visible) {
+                for lane in lanes_of(trace(world, batch, &segments, traced, ctx)) {
                     sum += contributions[lane];
                 }
             }
@@ -116,7 +113,7 @@ impl<B: Bsdf> Receiver<'_, B> {
         match lambertian {
             Some(f) => {
                 let total = lane_weights.iter().fold(0.0, |total, &weight| total + weight);
-                sum + f * lights.lights()[light as usize].emission * total
+                sum + f * area_light.emission * total
             }
             None => sum,
         }
@@ -210,6 +207,20 @@ impl<B> Receiver<'_, B> {
     fn faces(&self, sample: &LightSample) -> bool {
         !(self.surface.ns.dot(sample.wi) <= 0.0 || self.surface.ng.dot(sample.wi) <= 0.0)
     }
+}
+
+/// Traces the `traced` shadow segments of a group of light points (from the batch's origin, ending
+/// at `t = 1`, SoA) against the batch, counting them; the lanes that reach the light.
+#[inline(always)]
+fn trace(
+    world: &World,
+    batch: &OriginBatch,
+    segments: &[[f32; LANES]; 3],
+    traced: u32,
+    ctx: &mut SampleContext,
+) -> u32 {
+    ctx.rays += u64::from(traced.count_ones());
+    traced & !world.occluded_lanes_in_batch(batch, segments, 1.0, traced)
 }
 
 /// False when no point of the light can contribute: the light lies wholly below the surface's

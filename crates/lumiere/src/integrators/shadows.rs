@@ -102,7 +102,7 @@ struct DiffuseLanes {
 impl DiffuseLanes {
     fn set(&mut self, lane: usize, surface: &SurfacePoint, f: Vec3) {
         self.live |= 1 << lane;
-        let origin = offset_ray_origin(surface.p, surface.ng);
+        let origin = surface.offset_origin(surface.ng);
         for (rows, value) in [
             (&mut self.p, surface.p),
             (&mut self.ns, surface.ns),
