@@ -187,15 +187,20 @@ impl Accel {
         if !batch.traverses() {
             return batch.occluded_lanes(dirs, tmax);
         }
-        let mut blocked = 0;
-        let mut rays = live;
-        while rays != 0 {
-            let lane = rays.trailing_zeros() as usize;
-            rays &= rays - 1;
-            let dir = Vec3::new(dirs[0][lane], dirs[1][lane], dirs[2][lane]);
-            blocked |= u32::from(self.occluded(&Ray { origin: batch.origin(), dir, tmax })) << lane;
-        }
-        blocked
+        self.occluded_from_origin(batch.origin(), dirs, tmax, live)
+    }
+
+    /// [`WideBvh::occluded_from_origin`]: rays from one point, walked together where they share
+    /// nodes. Call it inside [`Accel::simd`], so that its loops over the rays get the ISA's width.
+    #[inline(always)]
+    pub fn occluded_from_origin<const N: usize>(
+        &self,
+        origin: Vec3,
+        dirs: &[[f32; N]; 3],
+        tmax: f32,
+        live: u32,
+    ) -> u32 {
+        with_bvh!(self, bvh => bvh.occluded_from_origin(origin, dirs, tmax, live))
     }
 
     /// [`Accel::occluded`] for a ray of a batch prepared with [`Accel::prepare_batch`].

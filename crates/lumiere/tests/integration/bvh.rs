@@ -353,6 +353,59 @@ fn origin_batches_agree_with_traversal() {
     assert!(differ * 10_000 <= rays, "{differ} of {rays} rays differ");
 }
 
+/// Rays sharing an origin, walked together (as ambient occlusion's probes are where a scene is
+/// too large for a batch): every lane answers as brute force does, on every ISA, for any mix of
+/// directions (zero and negative-zero components, the axes, both ways), origins on triangles'
+/// corners and edges, rays and segments, and any live lanes (dead ones answer 0).
+#[test]
+fn rays_from_one_origin_walked_together_match_brute_force() {
+    let mut rng = TestRng(4242);
+    let mut blocked_lanes = 0;
+    for mesh_index in 0..60 {
+        let (positions, indices) = random_mesh(&mut rng, 2 + mesh_index % 5);
+        let accels: Vec<Accel> = Isa::supported()
+            .into_iter()
+            .map(|isa| Accel::build(&positions, &indices, BuildPreset::Default, isa))
+            .collect();
+        for _ in 0..6 {
+            let origin = match rng.below(3) {
+                0 if !positions.is_empty() => positions[rng.below(positions.len())],
+                1 if positions.len() >= 2 => positions[0].lerp(positions[1], 0.5),
+                _ => rng.vec3(-12.0, 12.0) * if mesh_index % 5 == 3 { 1e18 } else { 1.0 },
+            };
+            let segment = rng.f32() < 0.5;
+            let directions: [Vec3; 16] = std::array::from_fn(|lane| {
+                let mut d = match lane % 4 {
+                    0 => [Vec3::X, Vec3::NEG_X, Vec3::Y, Vec3::NEG_Y, Vec3::Z, Vec3::NEG_Z][rng.below(6)],
+                    _ => rng.direction(),
+                };
+                match lane % 8 {
+                    1 => d.x = 0.0,
+                    3 => d.y = -0.0,
+                    _ => {}
+                }
+                if segment { d * rng.range(0.5, 30.0) } else { d }
+            });
+            let dirs: [[f32; 16]; 3] = std::array::from_fn(|axis| directions.map(|d| d[axis]));
+            let tmax = if segment { 1.0 } else { f32::INFINITY };
+            let live = if rng.f32() < 0.5 { 0xFFFF } else { rng.below(1 << 16) as u32 };
+            let mut expected = 0u32;
+            for (lane, &dir) in directions.iter().enumerate() {
+                let hit =
+                    live & (1 << lane) != 0 && brute_force(&positions, &indices, &Ray { origin, dir, tmax }).is_some();
+                expected |= u32::from(hit) << lane;
+            }
+            blocked_lanes += expected.count_ones();
+            for accel in &accels {
+                let isa = accel.isa();
+                let blocked = accel.simd(|| accel.occluded_from_origin(origin, &dirs, tmax, live));
+                assert_eq!(blocked, expected, "mesh {mesh_index}: {isa} from {origin:?}, live {live:#x}");
+            }
+        }
+    }
+    assert!(blocked_lanes > 300, "only {blocked_lanes} lanes blocked: the test asks too little");
+}
+
 /// A closed mesh seen from inside: no batched ray escapes, through vertices and edges included.
 #[test]
 fn origin_batches_never_leak_through_a_closed_mesh() {

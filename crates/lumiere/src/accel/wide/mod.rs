@@ -11,6 +11,7 @@ mod collapse;
 mod leaf;
 mod node;
 mod packet;
+mod shared_origin;
 mod traverse;
 mod triangles;
 

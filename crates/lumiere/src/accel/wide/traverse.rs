@@ -18,27 +18,28 @@ use crate::math::Ray;
 /// cost more than the whole traversal of a small scene. A wide level pushes at most `W - 1`
 /// siblings (`W` in a packet walk, `packet.rs`, which pops the nearest right after), so
 /// `(W - 1) * MAX_DEPTH + 1` entries would do; stable Rust cannot size an array by an expression of
-/// a const parameter, so the stack holds one row of `W` entries per level.
-pub(super) struct Stack<const W: usize> {
-    entries: [[MaybeUninit<(u32, f32)>; W]; MAX_DEPTH + 1],
+/// a const parameter, so the stack holds one row of `W` entries per level. An entry is a node
+/// reference with its entry distance, or with the lanes that entered it (`shared_origin.rs`).
+pub(super) struct Stack<const W: usize, T: Copy = (u32, f32)> {
+    entries: [[MaybeUninit<T>; W]; MAX_DEPTH + 1],
     len: usize,
 }
 
-impl<const W: usize> Stack<W> {
+impl<const W: usize, T: Copy> Stack<W, T> {
     #[inline(always)]
     pub(super) fn new() -> Self {
         Stack { entries: [[MaybeUninit::uninit(); W]; MAX_DEPTH + 1], len: 0 }
     }
 
     #[inline(always)]
-    pub(super) fn push(&mut self, entry: (u32, f32)) {
+    pub(super) fn push(&mut self, entry: T) {
         // The build bounds the depth by MAX_DEPTH and each level pushes at most W - 1 entries.
         self.entries.as_flattened_mut()[self.len] = MaybeUninit::new(entry);
         self.len += 1;
     }
 
     #[inline(always)]
-    pub(super) fn pop(&mut self) -> Option<(u32, f32)> {
+    pub(super) fn pop(&mut self) -> Option<T> {
         self.len = self.len.checked_sub(1)?;
         // SAFETY: entries below `len` were written by `push` before `len` grew past them.
         Some(unsafe { self.entries.as_flattened()[self.len].assume_init() })
@@ -55,7 +56,7 @@ pub(super) fn near_row(d: f32, axis: usize) -> usize {
 }
 
 /// The ray, splatted for the box tests.
-struct BoxRay<L> {
+pub(super) struct BoxRay<L> {
     /// Per axis, the bounds row that holds the entry (near) plane: min when the direction is positive.
     near_row: [usize; 3],
     origin: [L; 3],
@@ -64,7 +65,7 @@ struct BoxRay<L> {
 
 impl<L> BoxRay<L> {
     #[inline(always)]
-    fn new<const W: usize>(ray: &Ray) -> Self
+    pub(super) fn new<const W: usize>(ray: &Ray) -> Self
     where
         L: Lanes<W>,
     {
@@ -220,10 +221,24 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
     ) -> bool {
         let box_ray = BoxRay::<L>::new::<W>(ray);
         let tri_ray = TriangleRay::<L>::new::<W>(ray);
-        let tmax = ray.tmax;
+        self.occluded_below::<COUNT>(0, &box_ray, &tri_ray, ray.tmax, stats, keep)
+    }
+
+    /// Whether the ray (`box_ray`, `tri_ray`, `tmax`) is blocked by a triangle under the node or
+    /// leaf `start` (0: the root) that `keep` accepts.
+    #[inline(always)]
+    pub(super) fn occluded_below<const COUNT: bool>(
+        &self,
+        start: u32,
+        box_ray: &BoxRay<L>,
+        tri_ray: &TriangleRay<L>,
+        tmax: f32,
+        stats: &mut TraversalStats,
+        keep: impl Fn(u32, f32, f32) -> bool,
+    ) -> bool {
         let tmax_lanes = L::splat(tmax * PRUNE_SLACK);
         let mut stack = Stack::<W>::new();
-        let mut current = (0u32, 0f32);
+        let mut current = (start, 0f32);
         loop {
             let (reference, _) = current;
             if reference & LEAF_BIT != 0 {
@@ -231,7 +246,7 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
                     if COUNT {
                         stats.blocks += 1;
                     }
-                    let hits = intersect_block(&tri_ray, block, tmax);
+                    let hits = intersect_block(tri_ray, block, tmax);
                     if lanes_of(hits.mask).any(|lane| keep(block.ids[lane], hits.u[lane], hits.v[lane])) {
                         return true;
                     }
