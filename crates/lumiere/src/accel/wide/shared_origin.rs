@@ -28,6 +28,7 @@ use super::triangles::{TriangleRay, intersect_block};
 use crate::accel::TraversalStats;
 use crate::accel::simd::{Lanes, lanes_of, max_ps, min_ps};
 use crate::accel::slab::{BOX_EXPANSION, PRUNE_SLACK, safe_reciprocal};
+use crate::geometry::triangle::WatertightRay;
 use crate::math::Ray;
 
 /// Subtrees that at most half of the rays entered are walked ray by ray. A node's ray-major test
@@ -109,8 +110,9 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
         // Lanes outside `live` take a live lane's ray: whatever their directions, they build
         // harmless vectors, and their bits are masked out.
         let first = live.trailing_zeros() as usize;
-        let triangle_rays: [TriangleRay<L>; N] =
-            std::array::from_fn(|lane| TriangleRay::new::<W>(&ray(if live & (1 << lane) != 0 { lane } else { first })));
+        // Kept scalar and splatted where used: sixteen splatted rays were copied about as a whole.
+        let triangle_rays: [WatertightRay; N] =
+            std::array::from_fn(|lane| WatertightRay::new(&ray(if live & (1 << lane) != 0 { lane } else { first })));
         let mut rays = Rays {
             origin: origin.to_array(),
             negative: [[false; N]; 3],
@@ -139,7 +141,7 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
                     let hit = self.occluded_below::<false>(
                         reference,
                         &box_ray,
-                        &triangle_rays[lane],
+                        &TriangleRay::<L>::splat::<W>(triangle_rays[lane]),
                         tmax,
                         stats,
                         |_, _, _| true,
@@ -151,7 +153,9 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
             if reference & LEAF_BIT != 0 {
                 for block in &self.blocks[leaf::blocks::<W>(reference)] {
                     for lane in lanes_of(lanes & !blocked) {
-                        blocked |= u32::from(intersect_block(&triangle_rays[lane], block, tmax).mask != 0) << lane;
+                        blocked |= u32::from(
+                            intersect_block(&TriangleRay::<L>::splat::<W>(triangle_rays[lane]), block, tmax).mask != 0,
+                        ) << lane;
                     }
                 }
                 continue;

@@ -23,9 +23,17 @@ impl<L> TriangleRay<L> {
     where
         L: Lanes<W>,
     {
-        let scalar = WatertightRay::new(ray);
+        Self::splat(WatertightRay::new(ray))
+    }
+
+    /// The ray of `scalar`, splatted.
+    #[inline(always)]
+    pub(super) fn splat<const W: usize>(scalar: WatertightRay) -> Self
+    where
+        L: Lanes<W>,
+    {
         let (k, shear) = scalar.permutation_and_shear();
-        TriangleRay { scalar, k, origin: ray.origin.to_array().map(L::splat), shear: shear.map(L::splat) }
+        TriangleRay { scalar, k, origin: scalar.origin.to_array().map(L::splat), shear: shear.map(L::splat) }
     }
 }
 
