@@ -16,7 +16,8 @@ use crate::math::Ray;
 
 /// The traversal stack, left uninitialised: zeroing it (2.3 KB per ray at `W = 4`) was measured to
 /// cost more than the whole traversal of a small scene. A wide level pushes at most `W - 1`
-/// siblings (`W` in a packet walk, `packet.rs`, which pops the nearest right after), so
+/// siblings (`W` in the walks of `packet.rs` and `shared_origin.rs`, which pop the nearest right
+/// after), so
 /// `(W - 1) * MAX_DEPTH + 1` entries would do; stable Rust cannot size an array by an expression of
 /// a const parameter, so the stack holds one row of `W` entries per level. An entry is a node
 /// reference with its entry distance, or with the lanes that entered it (`shared_origin.rs`).
