@@ -1,5 +1,5 @@
-//! From the binary tree to the wide one: each wide node takes its binary node's children and keeps
-//! opening the largest interior child (by surface area, the one most rays enter) until it has `W`.
+//! From the binary tree to the wide one: each wide node takes up to `W` binary descendants as its
+//! children, those that the collapse plan (`collapse_plan.rs`) found cheapest for the SAH.
 //!
 //! The leaves' triangle blocks are laid out in the binary tree's leaf order (spatially coherent)
 //! and filled in parallel before the nodes are collapsed: gathering every triangle's corners is
@@ -11,6 +11,7 @@ use std::mem::MaybeUninit;
 use glam::Vec3;
 use rayon::prelude::*;
 
+use super::collapse_plan::CollapsePlan;
 use super::node::{TriangleBlock, WideNode};
 use super::{WideBvh, leaf};
 use crate::accel::bvh2::{Bvh, Node};
@@ -51,38 +52,17 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
                 set_child(&mut wide.nodes[0], 0, leaf, root);
             }
         } else {
-            wide.collapse(bvh, &first_block_of_leaf, 0);
+            let plan = CollapsePlan::<W>::new(bvh);
+            wide.collapse(bvh, &plan, &first_block_of_leaf, 0);
         }
         wide
     }
 
     /// Writes the wide node for binary interior node `index` (and its subtree); returns its index.
-    fn collapse(&mut self, bvh: &Bvh, first_block_of_leaf: &[u32], index: usize) -> u32 {
+    fn collapse(&mut self, bvh: &Bvh, plan: &CollapsePlan<W>, first_block_of_leaf: &[u32], index: usize) -> u32 {
         let nodes = bvh.nodes();
-        let node = &nodes[index];
-        // The children so far and their half areas (those of leaves -1: never opened).
-        let area = |c: usize| if nodes[c].is_leaf() { -1.0 } else { nodes[c].bounds().half_area() };
-        let (mut children, mut areas) = ([0usize; W], [0f64; W]);
-        for (slot, child) in [node.first as usize, node.first as usize + 1].into_iter().enumerate() {
-            (children[slot], areas[slot]) = (child, area(child));
-        }
-        let mut count = 2;
-        while count < W {
-            // The widest interior child, the last of equals.
-            let mut widest = 0;
-            for slot in 1..count {
-                if areas[slot] >= areas[widest] {
-                    widest = slot;
-                }
-            }
-            if areas[widest] < 0.0 {
-                break;
-            }
-            let first = nodes[children[widest]].first as usize;
-            (children[widest], areas[widest]) = (first, area(first));
-            (children[count], areas[count]) = (first + 1, area(first + 1));
-            count += 1;
-        }
+        let mut children = [0usize; W];
+        let count = plan.children_of(nodes, index, &mut children);
         let wide_index = self.nodes.len();
         self.nodes.push(WideNode::empty());
         for (slot, &child) in children[..count].iter().enumerate() {
@@ -91,7 +71,7 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
                 let first_block = first_block_of_leaf[child] as usize;
                 leaf::encode::<W>(first_block, (binary.count as usize).div_ceil(W))
             } else {
-                self.collapse(bvh, first_block_of_leaf, child)
+                self.collapse(bvh, plan, first_block_of_leaf, child)
             };
             set_child(&mut self.nodes[wide_index], slot, reference, binary);
         }

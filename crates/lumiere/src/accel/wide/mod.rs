@@ -8,6 +8,7 @@
 //! AVX-512 kernels.
 
 mod collapse;
+mod collapse_plan;
 mod leaf;
 mod node;
 mod packet;
