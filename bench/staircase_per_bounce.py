@@ -5,8 +5,10 @@ within 2x), both rendered by lumiere in one run, interleaved, so that a change o
 Each repeat renders the box (`--mode path`, 512x384) and then the staircase with the README's
 camera and emission (360x640, half the README's size), at the same spp and thread count, and reads
 `render_ms` and `rays` from `--stats-json`. A ray is one closest-hit or shadow query, lumiere's
-count; the ratio per ray stands for the ratio per path segment (a segment is one closest-hit
-query and at most one shadow query in both scenes). With `--full`, it also renders the staircase
+count. The target is per path segment (one closest-hit query, and at most one shadow query), and
+the staircase's paths trace a few more shadow queries per segment than the box's, so its ratio
+per segment is about 4% above the ratio per ray printed here (bench/README.md, "Caveats"). With
+`--full`, it also renders the staircase
 once at the target's 720x1280 and 64 spp and reports the time. Prints Markdown on stdout, progress
 on stderr.
 
@@ -117,9 +119,11 @@ def main():
         runs = ", ".join(f"{t:,.1f}" for t in times[name])
         print(f"| {name} | {size} | {median:,.1f} | {runs} | {rays[name]:,} | {per_ray[name]:.2f} |")
     ratio = per_ray["staircase"] / per_ray["Cornell box (built in)"]
-    verdict = "met" if ratio <= TARGET_RATIO else "not met"
+    # Judged per ray, which is about 4% kinder than per segment: "met" here still needs a look.
+    verdict = "met per ray" if ratio <= TARGET_RATIO else "not met"
     print()
-    print(f"Staircase against the box, per ray: **{ratio:.2f}x** (target {TARGET_RATIO:g}x: {verdict}).")
+    print(f"Staircase against the box, per ray: **{ratio:.2f}x** (target {TARGET_RATIO:g}x per path segment: "
+          f"{verdict}; per segment about 4% higher, see bench/README.md).")
     if full_ms is not None:
         print(f"The staircase at 720x1280, 64 spp, {args.threads} threads: {full_ms / 1e3:,.2f} s (one render).")
 
