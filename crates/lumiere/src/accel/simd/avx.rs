@@ -158,6 +158,11 @@ impl<V: AvxLevel> Lanes<8> for F32x8<V> {
         // SAFETY: the level's features are present (see `dispatch`).
         unsafe { F32x8::new(_mm256_andnot_ps(_mm256_set1_ps(-0.0), self.0)) }
     }
+    #[inline(always)]
+    fn select_by_sign(sign: Self, if_negative: Self, otherwise: Self) -> Self {
+        // SAFETY: the level's features are present (see `dispatch`); `vblendvps` reads each lane's sign bit.
+        unsafe { F32x8::new(_mm256_blendv_ps(otherwise.0, if_negative.0, sign.0)) }
+    }
 }
 
 impl<V> Add for F32x8<V> {

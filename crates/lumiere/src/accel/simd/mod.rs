@@ -69,6 +69,9 @@ pub trait Lanes<const W: usize>:
     fn ne(self, b: Self) -> Self::Mask;
     /// Lane-wise absolute value (clears the sign bit).
     fn abs(self) -> Self;
+    /// `if_negative`'s lane where `sign`'s lane has its sign bit set (-0.0 and negative NaNs
+    /// included), `otherwise`'s elsewhere: a choice by a direction's sign read off its reciprocal.
+    fn select_by_sign(sign: Self, if_negative: Self, otherwise: Self) -> Self;
 
     /// Lanes that are neither infinite nor NaN.
     #[inline(always)]

@@ -73,6 +73,10 @@ impl<const W: usize> Lanes<W> for F32xN<W> {
     fn abs(self) -> Self {
         F32xN(self.0.map(f32::abs))
     }
+    #[inline(always)]
+    fn select_by_sign(sign: Self, if_negative: Self, otherwise: Self) -> Self {
+        F32xN(std::array::from_fn(|i| if sign.0[i].is_sign_negative() { if_negative.0[i] } else { otherwise.0[i] }))
+    }
 }
 
 impl<const W: usize> Add for F32xN<W> {

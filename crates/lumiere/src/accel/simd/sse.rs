@@ -74,6 +74,15 @@ impl Lanes<4> for F32x4 {
         // SAFETY: SSE is part of the x86-64 baseline.
         unsafe { F32x4(_mm_andnot_ps(_mm_set1_ps(-0.0), self.0)) }
     }
+    #[inline(always)]
+    fn select_by_sign(sign: Self, if_negative: Self, otherwise: Self) -> Self {
+        // SAFETY: SSE2 is part of the x86-64 baseline. The arithmetic shift spreads each sign bit
+        // over its lane (SSE4.1's `blendvps` is not in the baseline).
+        unsafe {
+            let negative = _mm_castsi128_ps(_mm_srai_epi32::<31>(_mm_castps_si128(sign.0)));
+            F32x4(_mm_or_ps(_mm_and_ps(negative, if_negative.0), _mm_andnot_ps(negative, otherwise.0)))
+        }
+    }
 }
 
 impl Add for F32x4 {
