@@ -167,7 +167,9 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
                 if child == EMPTY_CHILD {
                     continue;
                 }
-                let mask = rays.enter::<W, L>(node, slot, lanes);
+                // Every ray leaves from inside a box that holds the origin (the slab test would
+                // say so too; a distance that underflows to 0 only adds a box, never drops one).
+                let mask = if distance == 0.0 { lanes } else { rays.enter::<W, L>(node, slot, lanes) };
                 if mask == 0 {
                     continue;
                 }
