@@ -23,7 +23,9 @@ import statistics
 import subprocess
 import sys
 import tempfile
-import time
+
+# The side-by-side script's helpers (this folder is on the import path when a script here runs).
+from embree_side_by_side import git_commit, progress
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -43,10 +45,6 @@ def fail(message):
     sys.exit(2)
 
 
-def progress(message):
-    print(f"[{time.strftime('%H:%M:%S')}] {message}", file=sys.stderr, flush=True)
-
-
 def render(lumiere, scene_args, size, spp, threads, workdir):
     """Renders once; returns (render_ms, rays) from the stats JSON."""
     stats = os.path.join(workdir, "stats.json")
@@ -58,16 +56,6 @@ def render(lumiere, scene_args, size, spp, threads, workdir):
     with open(stats) as f:
         data = json.load(f)
     return data["render_ms"], data["rays"]
-
-
-def git_commit():
-    try:
-        out = subprocess.run(["git", "-C", REPO, "rev-parse", "--short", "HEAD"], capture_output=True, text=True)
-        dirty = subprocess.run(["git", "-C", REPO, "status", "--porcelain", "--untracked-files=no"],
-                               capture_output=True, text=True).stdout.strip()
-        return out.stdout.strip() + (" (with uncommitted changes)" if dirty else "")
-    except OSError:
-        return "unknown"
 
 
 def main():

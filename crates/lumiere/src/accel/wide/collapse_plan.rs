@@ -52,23 +52,22 @@ impl<const W: usize> CollapsePlan<W> {
             return;
         }
         let (left, right) = (node.first as usize, node.first as usize + 1);
-        // The best spread of `slots` roots over the two subtrees (each gets at least one).
-        let spread = |slots: usize| -> (f64, u8) {
-            let mut best = (f64::INFINITY, 0u8);
+        // `spread[slots - 1]`: the best spread of `slots` roots over the two subtrees (each gets
+        // at least one), as its cost and the roots that go left (`slots` from 2).
+        let mut spread = [(f64::INFINITY, 0u8); W];
+        for slots in 2..=W {
             for to_left in 1..slots {
                 let cost = self.cost[left][to_left - 1] + self.cost[right][slots - to_left - 1];
-                if cost < best.0 {
-                    best = (cost, to_left as u8);
+                if cost < spread[slots - 1].0 {
+                    spread[slots - 1] = (cost, to_left as u8);
                 }
             }
-            best
-        };
-        let (children_cost, as_node_split) = spread(W);
+        }
         let mut cost = [0.0; W];
         let mut split = [0u8; W];
-        (cost[0], split[0]) = (node.bounds().half_area() + children_cost, as_node_split);
+        (cost[0], split[0]) = (node.bounds().half_area() + spread[W - 1].0, spread[W - 1].1);
         for slots in 2..=W {
-            let (spread_cost, to_left) = spread(slots);
+            let (spread_cost, to_left) = spread[slots - 1];
             // Fewer roots on a tie: the parent keeps slots for its other children.
             (cost[slots - 1], split[slots - 1]) =
                 if spread_cost < cost[slots - 2] { (spread_cost, to_left) } else { (cost[slots - 2], 0) };
