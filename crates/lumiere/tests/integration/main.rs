@@ -10,6 +10,7 @@ mod estimators;
 mod film;
 mod hostile_inputs;
 mod image_io;
+mod mip_maps;
 mod module_graph;
 mod obj_loading;
 mod packets;
