@@ -105,27 +105,6 @@ impl World {
         self.kinds[id].bsdf(base)
     }
 
-    /// [`World::bsdf`] for a ray of unit direction `dir` whose cone (`integrators::RayCone`) is
-    /// `cone_width` wide at `surface`: its texture read at the mip level of that footprint, whose
-    /// area in texels² is the triangle's texel area over its world area (Akenine-Möller et al.
-    /// 2019) times `width² / |cos θ|`, the area of a footprint `width` wide and `width / |cos θ|`
-    /// long.
-    #[inline]
-    pub fn bsdf_in_cone(&self, surface: &SurfacePoint, dir: Vec3, cone_width: f32) -> MaterialBsdf {
-        let id = surface.material as usize;
-        let base = match self.texture_of_material[id] {
-            Some(texture) => {
-                let image = self.textures.get(texture);
-                let texels_per_uv = image.width() as f32 * image.height() as f32;
-                let cos = surface.ng.dot(dir).abs();
-                let footprint = surface.uv_per_area * texels_per_uv * (cone_width * cone_width / cos);
-                image.sample_footprint(surface.uv, footprint)
-            }
-            None => self.scene.materials[id].kd,
-        };
-        self.kinds[id].bsdf(base)
-    }
-
     /// The instruction set the BVH was built for.
     pub fn isa(&self) -> Isa {
         self.accel.isa()
@@ -257,18 +236,12 @@ impl World {
         let [p0, p1, p2] = mesh.vertices(id);
         let w = 1.0 - hit.u - hit.v;
         let p = w * p0 + hit.u * p1 + hit.v * p2;
-        let cross = (p1 - p0).cross(p2 - p0);
-        let geometric = cross.normalize_or_zero();
+        let geometric = (p1 - p0).cross(p2 - p0).normalize_or_zero();
         let front_face = geometric.dot(ray.dir) <= 0.0;
         let ng = if front_face { geometric } else { -geometric };
         let ns = self.interpolated_normal(id, w, hit.u, hit.v).map_or(ng, |n| if n.dot(ng) < 0.0 { -n } else { n });
-        let (uv, uv_per_area) = match self.texcoords_of(id) {
-            Some([t0, t1, t2]) => {
-                (w * t0 + hit.u * t1 + hit.v * t2, (t1 - t0).perp_dot(t2 - t0).abs() / cross.length())
-            }
-            None => (Vec2::ZERO, 0.0),
-        };
-        SurfacePoint { p, ng, ns, uv, uv_per_area, triangle: hit.triangle, material: mesh.material_ids[id], front_face }
+        let uv = self.interpolated_texcoord(id, w, hit.u, hit.v);
+        SurfacePoint { p, ng, ns, uv, triangle: hit.triangle, material: mesh.material_ids[id], front_face }
     }
 
     fn interpolated_normal(&self, id: usize, w: f32, u: f32, v: f32) -> Option<Vec3> {
@@ -281,18 +254,12 @@ impl World {
         n.try_normalize()
     }
 
-    /// The texture coordinates of triangle `id`'s corners, if the file gave them.
-    fn texcoords_of(&self, id: usize) -> Option<[Vec2; 3]> {
-        let mesh = &self.scene.mesh;
-        let &[a, b, c] = mesh.texcoord_indices.get(id)?;
-        if a == NO_INDEX || b == NO_INDEX || c == NO_INDEX {
-            return None;
-        }
-        Some([a, b, c].map(|i| mesh.texcoords[i as usize]))
-    }
-
-    /// The texture coordinates at barycentrics `(w, u, v)` of triangle `id` (zero without `vt`).
     fn interpolated_texcoord(&self, id: usize, w: f32, u: f32, v: f32) -> Vec2 {
-        self.texcoords_of(id).map_or(Vec2::ZERO, |[t0, t1, t2]| w * t0 + u * t1 + v * t2)
+        let mesh = &self.scene.mesh;
+        let Some(&[a, b, c]) = mesh.texcoord_indices.get(id) else { return Vec2::ZERO };
+        if a == NO_INDEX || b == NO_INDEX || c == NO_INDEX {
+            return Vec2::ZERO;
+        }
+        w * mesh.texcoords[a as usize] + u * mesh.texcoords[b as usize] + v * mesh.texcoords[c as usize]
     }
 }

@@ -17,9 +17,6 @@ pub struct SurfacePoint {
     pub ns: Vec3,
     /// Texture coordinates interpolated from the file's `vt` (zero when it has none).
     pub uv: Vec2,
-    /// The triangle's area in texture coordinates over its area in the scene (0 without `vt`;
-    /// NaN or infinite for a degenerate triangle): how many texels a footprint covers.
-    pub uv_per_area: f32,
     pub triangle: u32,
     /// Index of the triangle's material in the scene.
     pub material: u32,

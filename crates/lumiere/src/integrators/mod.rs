@@ -6,7 +6,6 @@ mod direct;
 mod hits;
 mod materials;
 mod path;
-mod ray_cone;
 mod shadows;
 
 use glam::Vec3;
@@ -23,7 +22,6 @@ pub use direct::{Direct, LightSampling};
 pub use hits::Hits;
 pub use materials::Materials;
 pub use path::{Path, PathStrategy};
-pub use ray_cone::{FOOTPRINT_SAMPLES, RayCone};
 pub use shadows::Shadows;
 
 /// What a render computes per pixel, with the options of that technique.
@@ -89,8 +87,6 @@ pub struct SampleContext<'a> {
     /// Reused buffer for shared-origin ray batches (one per thread, never shared).
     pub batch: OriginBatch,
     pub rays: u64,
-    /// The cone of the camera rays ([`RayCone`]), which texture lookups filter over.
-    pub camera_cone: RayCone,
     /// True once the render must stop (Ctrl-C, time budget). Integrators whose pixels can take
     /// long (thousands of samples or lights) poll it every [`STOP_POLL`] samples and return early;
     /// the pass is then abandoned, so the value they return is never used.

@@ -124,12 +124,9 @@ impl Integrator for Path {
         // or the camera), for the MIS weight of the light that ray hits.
         let mut previous_pdf = f32::INFINITY;
         let mut depth = 0u32;
-        // How wide the path is where it hits, for texture filtering.
-        let mut cone = ctx.camera_cone;
         loop {
             ctx.rays += 1;
             let Some(hit) = world.intersect(&ray) else { break };
-            let cone_width = cone.advance(hit.t);
 
             // Emission: the light this ray found, weighted against having sampled it as a light.
             if let Some(light) = lights.light_of(hit.triangle) {
@@ -149,7 +146,7 @@ impl Integrator for Path {
             }
 
             let surface = world.surface(&ray, &hit);
-            let bsdf = world.bsdf_in_cone(&surface, ray.dir, cone_width);
+            let bsdf = world.bsdf(&surface);
             // Opaque lobes scatter on the viewer's side, where `ns` is turned; a transmissive one
             // needs its own orientation (`wo.z < 0` means inside), so its frame keeps the normal's.
             let normal = if bsdf.transmits() && !surface.front_face { -surface.ns } else { surface.ns };
@@ -188,9 +185,6 @@ impl Integrator for Path {
             throughput *= scattered.f * (scattered.wi.z.abs() / scattered.pdf);
             let specular = scattered.flags.contains(BsdfFlags::SPECULAR);
             previous_pdf = if specular { f32::INFINITY } else { scattered.pdf };
-            if !specular {
-                cone.scatter(scattered.pdf);
-            }
             ray = surface.spawn_ray(wi);
 
             // Russian roulette, after `rr_depth` segments: survive with probability q, weigh by 1/q.

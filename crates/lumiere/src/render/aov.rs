@@ -9,7 +9,6 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
-use crate::integrators::RayCone;
 use crate::materials::Bsdf;
 use crate::render::RenderOptions;
 use crate::render::camera_sample;
@@ -57,8 +56,6 @@ pub fn render_aovs(world: &World, camera: &Camera, options: &RenderOptions, aovs
     let samples = options.spp.clamp(1, AOV_SAMPLES);
     let centre = options.samples_pixel_centres();
     let width = camera.width;
-    // The path tracer's first vertex, whose texture lookups filter over the camera's cone.
-    let camera_cone = RayCone::camera(camera.pixel_angle(), !centre);
     let rows: Vec<Vec<[Vec3; 3]>> = (0..camera.height)
         .into_par_iter()
         .map(|y| {
@@ -69,11 +66,9 @@ pub fn render_aovs(world: &World, camera: &Camera, options: &RenderOptions, aovs
                         let (ray, _) = camera_sample(camera, &sampler, (x, y), sample, centre);
                         let Some(hit) = world.intersect(&ray) else { continue };
                         let surface = world.surface(&ray, &hit);
-                        let (dir, distance) = (ray.dir.normalize(), hit.t * ray.dir.length());
-                        let cone_width = camera_cone.width_at(distance);
-                        sum[0] += world.bsdf_in_cone(&surface, dir, cone_width).albedo();
+                        sum[0] += world.bsdf(&surface).albedo();
                         sum[1] += surface.ns;
-                        sum[2] += Vec3::splat(distance);
+                        sum[2] += Vec3::splat(hit.t * ray.dir.length());
                     }
                     sum.map(|s| s / samples as f32)
                 })

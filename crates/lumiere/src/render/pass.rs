@@ -9,7 +9,7 @@ use rayon::prelude::*;
 
 use super::StopReason;
 use crate::accel::OriginBatch;
-use crate::integrators::{CameraPacket, Integrator, PACKET, RayCone, SampleContext};
+use crate::integrators::{CameraPacket, Integrator, PACKET, SampleContext};
 use crate::math::Ray;
 use crate::sampler::{SampleStream, Sampler};
 use crate::scene::camera::Camera;
@@ -130,8 +130,7 @@ fn shade_tile<I: Integrator>(
 ) -> Option<u64> {
     let stream = SampleStream::new(pass.sampler, 0, pass.sample);
     let stop = || stop_now().is_some();
-    let camera_cone = RayCone::camera(camera.pixel_angle(), !pass.pixel_centre);
-    let mut ctx = SampleContext { stream, batch: OriginBatch::default(), rays: 0, camera_cone, stop: &stop };
+    let mut ctx = SampleContext { stream, batch: OriginBatch::default(), rays: 0, stop: &stop };
     let mut pixels = 0;
     for by in (0..tile.rows.len()).step_by(BLOCK) {
         for bx in (0..tile.rows[by].len()).step_by(BLOCK) {

@@ -174,15 +174,6 @@ impl Camera {
         })
     }
 
-    /// The angle, in radians, between the rays through the centre of the film and one pixel below:
-    /// the spread of a pixel's ray cone (`integrators::RayCone`). The chord between the two unit
-    /// directions, which is the angle to within a part in 10⁵ for any field of view under 179°
-    /// at 2 pixels or more, in arithmetic alone (no libm: the same on every machine).
-    pub fn pixel_angle(&self) -> f32 {
-        let (x, y) = (0.5 * self.width as f32, 0.5 * self.height as f32);
-        (self.ray(x, y + 1.0).dir - self.ray(x, y).dir).length()
-    }
-
     /// The ray through film position `(x, y)` (top-left origin), with a unit direction.
     pub fn ray(&self, x: f32, y: f32) -> Ray {
         match &self.projection {

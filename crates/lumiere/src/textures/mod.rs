@@ -1,6 +1,6 @@
 //! Textures: image files decoded once, when the world is built, into linear RGB (8-bit files keep
-//! their codes and decode them through a table at each lookup; alpha where the file has one), with
-//! a mip chain for the colours (`mip.rs`), looked up with bilinear filtering and repeat wrapping.
+//! their codes and decode them through a table at each lookup; alpha where the file has one), and
+//! looked up with bilinear filtering and repeat wrapping.
 //!
 //! * **Colour.** PNG and JPEG store sRGB-encoded values; each channel is decoded with the exact
 //!   sRGB curve (IEC 61966-2-1: linear below 0.04045, a 2.4 power above), so texture values are
@@ -11,16 +11,19 @@
 //!   `u = (x + ½) / width`, `v = 1 − (y + ½) / height`. Outside `[0, 1)` coordinates repeat; at the
 //!   borders, bilinear filtering blends with the opposite edge, as repeat wrapping implies.
 //!   NaN, infinite and huge coordinates read a valid texel and never panic.
-//! * **Footprints.** [`Texture::sample`] reads the image itself; [`Texture::sample_footprint`]
-//!   reads the mip level of a footprint so many texels wide (the path tracer's ray cones,
-//!   `integrators::RayCone`), the image itself for footprints under two texels.
 //! * **Loading.** [`TextureSet::load`] decodes every distinct file once, in parallel; a file that
 //!   cannot be read or decoded costs one warning naming it, and the materials that use it keep
 //!   their `Kd`. Image sizes are checked against [`MAX_TEXELS`] from the header, before decoding.
-//!   [`TextureSet::for_materials`] builds the colour textures' mip chains; cutouts have none.
-
-mod level;
-mod mip;
+//!
+//! How `World::new` is meant to use it (it does not yet; the world owns the wiring):
+//!
+//! ```ignore
+//! let (texture_of_material, textures, warnings) =
+//!     TextureSet::for_materials(scene.materials.iter().map(|m| m.map_kd.as_deref()));
+//! // at a hit with material m and interpolated texture coordinates uv:
+//! let base = match texture_of_material[m] { Some(id) => textures.sample(id, uv), None => material.kd };
+//! let bsdf = material.bsdf(base);
+//! ```
 
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
@@ -30,8 +33,6 @@ use glam::{Vec2, Vec3};
 use image::{DynamicImage, ImageFormat, ImageReader, Limits};
 use rayon::prelude::*;
 
-use level::{Level, Texels};
-
 /// The most texels (width × height) an image may have: 2²⁶, e.g. 8192 × 8192, which takes 1 GiB
 /// as `f32` RGBA. Larger images are refused from their header, before any decoding.
 pub const MAX_TEXELS: u64 = 1 << 26;
@@ -39,14 +40,64 @@ pub const MAX_TEXELS: u64 = 1 << 26;
 /// The largest texture file read, in bytes (a compressed image of [`MAX_TEXELS`] is far smaller).
 pub const MAX_FILE_BYTES: u64 = 1 << 30;
 
-/// An image decoded to linear `f32` RGB with its mip chain (`mip.rs`), and its alpha channel when
-/// the file has one (full resolution only: cutouts test it at level 0).
+/// An image decoded to linear `f32` RGB, with its alpha channel when the file has one.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Texture {
-    /// The image as decoded, then its halvings down to one texel.
-    levels: Vec<Level>,
+    width: u32,
+    height: u32,
     /// Row-major from the top row of the image, as stored in the file.
+    rgb: Texels,
     alpha: Option<Vec<f32>>,
+}
+
+/// The colour of every texel: the 8-bit sRGB codes of most files, decoded through the table at
+/// each lookup (the same `f32` values, in a third of the memory: path tracing reads texels at
+/// random, and their cache misses were most of a textured scene's shading), or linear `f32` (16-bit
+/// files, [`Texture::from_linear`]).
+#[derive(Clone, Debug, PartialEq)]
+enum Texels {
+    /// RGB codes and a padding byte, so that a texel is one aligned 4-byte load.
+    Srgb8 {
+        codes: Vec<[u8; 4]>,
+        table: &'static [f32; 256],
+    },
+    Linear(Vec<Vec3>),
+}
+
+impl Texels {
+    #[inline]
+    fn get(&self, i: usize) -> Vec3 {
+        match self {
+            Texels::Srgb8 { codes, table } => {
+                let [r, g, b, _] = codes[i];
+                Vec3::new(table[r as usize], table[g as usize], table[b as usize])
+            }
+            Texels::Linear(rgb) => rgb[i],
+        }
+    }
+
+    /// Texel `i` read as a scalar (a coverage mask without an alpha channel): the luminance of the
+    /// values the file stores, without sRGB decoding (a mask is not a colour). 8-bit codes are
+    /// kept, over 255; 16-bit texels were decoded when loaded, and the encoding curve gives their
+    /// file values back (to within rounding), so that a mask reads the same at either depth.
+    #[inline]
+    fn scalar(&self, i: usize) -> f32 {
+        let stored = match self {
+            Texels::Srgb8 { codes, .. } => {
+                let [r, g, b, _] = codes[i];
+                Vec3::new(r.into(), g.into(), b.into()) / 255.0
+            }
+            Texels::Linear(rgb) => rgb[i].to_array().map(linear_to_srgb).into(),
+        };
+        stored.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+    }
+
+    fn memory_bytes(&self) -> usize {
+        match self {
+            Texels::Srgb8 { codes, .. } => codes.len() * 4,
+            Texels::Linear(rgb) => rgb.len() * std::mem::size_of::<Vec3>(),
+        }
+    }
 }
 
 impl Texture {
@@ -78,22 +129,12 @@ impl Texture {
     pub fn from_linear(width: u32, height: u32, rgb: Vec<Vec3>, alpha: Option<Vec<f32>>) -> Option<Texture> {
         let n = width as u64 * height as u64;
         let sizes_fit = rgb.len() as u64 == n && alpha.as_ref().is_none_or(|a| a.len() as u64 == n);
-        (sizes_fit && check_size(width, height).is_ok())
-            .then(|| Texture::new(width, height, Texels::Linear(rgb), alpha))
-    }
-
-    /// The texture of the decoded image `rgb`, without a mip chain yet.
-    fn new(width: u32, height: u32, rgb: Texels, alpha: Option<Vec<f32>>) -> Texture {
-        Texture { levels: vec![Level { width, height, rgb }], alpha }
-    }
-
-    /// Builds the mip chain (`mip.rs`), for [`Texture::sample_footprint`]; a third more memory. Until
-    /// then the texture has one level, which every level of detail reads.
-    pub fn build_mip_chain(&mut self) {
-        if self.levels.len() == 1 {
-            let halvings = mip::halvings(&self.levels[0]);
-            self.levels.extend(halvings);
-        }
+        (sizes_fit && check_size(width, height).is_ok()).then_some(Texture {
+            width,
+            height,
+            rgb: Texels::Linear(rgb),
+            alpha,
+        })
     }
 
     /// Converts a decoded image, whatever its channels and depth, to linear RGB(A).
@@ -128,23 +169,17 @@ impl Texture {
                 .collect();
             Texels::Srgb8 { codes, table: srgb_table() }
         };
-        Texture::new(width, height, rgb, has_alpha.then_some(alpha))
+        Texture { width, height, rgb, alpha: has_alpha.then_some(alpha) }
     }
 
     #[inline]
     pub fn width(&self) -> u32 {
-        self.levels[0].width
+        self.width
     }
 
     #[inline]
     pub fn height(&self) -> u32 {
-        self.levels[0].height
-    }
-
-    /// The number of images in the mip chain: 1 before [`Texture::build_mip_chain`], then
-    /// 1 + ⌈log₂ max(w, h)⌉.
-    pub fn levels(&self) -> usize {
-        self.levels.len()
+        self.height
     }
 
     /// Whether the file had an alpha channel ([`Texture::sample_alpha`] is 1 everywhere otherwise).
@@ -153,41 +188,32 @@ impl Texture {
         self.alpha.is_some()
     }
 
-    /// The bytes the texels take in memory, the mip chain's included.
+    /// The bytes the texels take in memory.
     pub fn memory_bytes(&self) -> usize {
-        self.levels.iter().map(|level| level.rgb.memory_bytes()).sum::<usize>()
-            + self.alpha.as_ref().map_or(0, |a| a.len() * 4)
+        self.rgb.memory_bytes() + self.alpha.as_ref().map_or(0, |a| a.len() * 4)
     }
 
     /// The linear colour of texel `(x, y)`, column `x` and row `y` counted from the top of the
     /// image as stored in the file; coordinates wrap around.
     #[inline]
     pub fn texel(&self, x: u32, y: u32) -> Vec3 {
-        let image = &self.levels[0];
-        image.rgb.get(image.index(x as i64, y as i64))
+        self.rgb.get(self.index(x as i64, y as i64))
     }
 
     /// The bilinearly filtered colour at texture coordinates `uv` (OBJ convention: `v = 0` is the
     /// bottom of the image), with repeat wrapping.
     #[inline]
     pub fn sample(&self, uv: Vec2) -> Vec3 {
-        self.levels[0].bilinear(uv)
-    }
-
-    /// The bilinearly filtered colour at `uv` of the mip level (`mip.rs`) a footprint of
-    /// `texels_squared` texels² of the image is read from: [`Texture::sample`] for footprints of
-    /// one texel or less (and NaN), the last level for those wider than the image.
-    #[inline]
-    pub fn sample_footprint(&self, uv: Vec2, texels_squared: f32) -> Vec3 {
-        let level = (mip::level_of_footprint(texels_squared) as usize).min(self.levels.len() - 1);
-        self.levels[level].bilinear(uv)
+        let [(i00, w00), (i10, w10), (i01, w01), (i11, w11)] = self.footprint(uv);
+        let rgb = &self.rgb;
+        rgb.get(i00) * w00 + rgb.get(i10) * w10 + rgb.get(i01) * w01 + rgb.get(i11) * w11
     }
 
     /// The bilinearly filtered alpha at `uv`; 1 (opaque) for images without alpha.
     #[inline]
     pub fn sample_alpha(&self, uv: Vec2) -> f32 {
         let Some(alpha) = &self.alpha else { return 1.0 };
-        self.levels[0].footprint(uv).iter().map(|&(i, w)| alpha[i] * w).sum()
+        self.footprint(uv).iter().map(|&(i, w)| alpha[i] * w).sum()
     }
 
     /// The bilinearly filtered coverage at `uv`, for cutouts (`map_d`): the alpha channel where the
@@ -198,9 +224,67 @@ impl Texture {
         if self.alpha.is_some() {
             return self.sample_alpha(uv);
         }
-        let image = &self.levels[0];
-        image.footprint(uv).iter().map(|&(i, w)| image.rgb.scalar(i) * w).sum()
+        self.footprint(uv).iter().map(|&(i, w)| self.rgb.scalar(i) * w).sum()
     }
+
+    /// The four texels around `uv` and their bilinear weights (which sum to 1).
+    #[inline]
+    fn footprint(&self, uv: Vec2) -> [(usize, f32); 4] {
+        // Continuous texel coordinates, with texel centres at integers; rows from the top.
+        let x = wrap_unit(uv.x) * self.width as f32 - 0.5;
+        let y = (1.0 - wrap_unit(uv.y)) * self.height as f32 - 0.5;
+        let (x0, y0) = (floor(x), floor(y));
+        let (fx, fy) = (x - x0, y - y0);
+        let (x0, y0) = (x0 as i64, y0 as i64);
+        [
+            (self.index(x0, y0), (1.0 - fx) * (1.0 - fy)),
+            (self.index(x0 + 1, y0), fx * (1.0 - fy)),
+            (self.index(x0, y0 + 1), (1.0 - fx) * fy),
+            (self.index(x0 + 1, y0 + 1), fx * fy),
+        ]
+    }
+
+    /// The storage index of texel `(x, y)`, wrapped into the image.
+    #[inline]
+    fn index(&self, x: i64, y: i64) -> usize {
+        wrap_texel(y, self.height) * self.width as usize + wrap_texel(x, self.width)
+    }
+}
+
+/// `i.rem_euclid(n)`. The footprint's texels lie in `-1 ..= n` (the coordinates come wrapped into
+/// `[0, 1]`), which two comparisons wrap: the integer division was a quarter of the staircase's
+/// render, eight of them per lookup.
+#[inline]
+fn wrap_texel(i: i64, n: u32) -> usize {
+    let n = i64::from(n);
+    let wrapped = if i < 0 {
+        i + n
+    } else if i >= n {
+        i - n
+    } else {
+        i
+    };
+    if (0..n).contains(&wrapped) { wrapped as usize } else { i.rem_euclid(n) as usize }
+}
+
+/// `t.floor()` for a finite `t`, without the libm call it compiles to on x86-64's baseline (SSE2
+/// has no rounding instruction): truncate, and step down for negative non-integers. Values of
+/// magnitude `2^23` and above are integers already. The result's sign of zero may differ from
+/// `floor`'s (`-0.0` gives `0.0`), which no use here can see.
+#[inline]
+fn floor(t: f32) -> f32 {
+    if t.abs() >= 8_388_608.0 {
+        return t;
+    }
+    let truncated = t as i32 as f32;
+    if truncated > t { truncated - 1.0 } else { truncated }
+}
+
+/// `t` wrapped into `[0, 1]` (repeat); 0 for NaN and infinities. The result can be exactly 1 for
+/// tiny negative `t` (`1 − 1e-9` rounds up), which the index wrapping handles.
+#[inline]
+fn wrap_unit(t: f32) -> f32 {
+    if t.is_finite() { t - floor(t) } else { 0.0 }
 }
 
 /// Refuses empty images and those of more than [`MAX_TEXELS`] texels.
@@ -297,10 +381,7 @@ impl TextureSet {
     pub fn for_materials<'a>(
         map_kd: impl IntoIterator<Item = Option<&'a Path>>,
     ) -> (Vec<Option<TextureId>>, TextureSet, Vec<String>) {
-        let (ids, mut set, warnings) = TextureSet::per_material(map_kd, "the material's Kd is used instead");
-        // Colours are looked up at each path vertex's footprint; cutouts only at full resolution.
-        set.textures.par_iter_mut().for_each(Texture::build_mip_chain);
-        (ids, set, warnings)
+        TextureSet::per_material(map_kd, "the material's Kd is used instead")
     }
 
     /// As [`TextureSet::for_materials`], for each material's coverage texture (`map_d`, for
@@ -345,12 +426,6 @@ impl TextureSet {
         self.get(id).sample(uv)
     }
 
-    /// The colour of texture `id` at `uv` under a footprint (see [`Texture::sample_footprint`]).
-    #[inline]
-    pub fn sample_footprint(&self, id: TextureId, uv: Vec2, texels_squared: f32) -> Vec3 {
-        self.get(id).sample_footprint(uv, texels_squared)
-    }
-
     pub fn len(&self) -> usize {
         self.textures.len()
     }
@@ -376,4 +451,28 @@ fn read_texture(path: &Path) -> Result<Texture, String> {
     }
     let bytes = crate::util::read::read_regular_file(path).map_err(|e| e.to_string())?;
     Texture::decode(&bytes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{floor, wrap_texel};
+
+    #[test]
+    fn floor_is_f32_floor() {
+        let mut values = vec![0.0f32, -0.0, 0.5, -0.5, 1.0, -1.0, 2.999_999_8, -2.999_999_8, 1e-30, -1e-30];
+        values.extend([8_388_607.5f32, -8_388_607.5, 8_388_608.0, -8_388_609.0, 1e30, -1e30, f32::MAX, f32::MIN]);
+        values.extend((0..10_000).map(|i| (i as f32 - 5000.0) * 0.37));
+        for t in values {
+            assert_eq!(floor(t), t.floor(), "{t}");
+        }
+    }
+
+    #[test]
+    fn wrap_texel_is_rem_euclid() {
+        for n in [1u32, 2, 3, 7, 1024] {
+            for i in -3 * i64::from(n) - 2..3 * i64::from(n) + 2 {
+                assert_eq!(wrap_texel(i, n), i.rem_euclid(i64::from(n)) as usize, "{i} mod {n}");
+            }
+        }
+    }
 }

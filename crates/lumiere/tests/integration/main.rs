@@ -10,7 +10,6 @@ mod estimators;
 mod film;
 mod hostile_inputs;
 mod image_io;
-mod mip_maps;
 mod module_graph;
 mod obj_loading;
 mod packets;

@@ -29,7 +29,6 @@ fn hard_shadow_packets_shade_mixed_materials_as_single_rays_do() {
         stream: SampleStream::new(&sampler, 0, 0),
         batch: OriginBatch::default(),
         rays: 0,
-        camera_cone: Default::default(),
         stop: &stop,
     };
     let (mut lit, mut compared) = (0, 0);
