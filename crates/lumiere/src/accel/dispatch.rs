@@ -11,7 +11,7 @@ use super::bvh2::{BuildPreset, Bvh};
 use super::simd::lanes_of;
 use super::simd::portable::F32xN;
 use super::wide::{PacketKey, RayPacket, WideBvh};
-use super::{Bvh4, Hit, Isa, OriginBatch, Region, TraversalStats};
+use super::{Bvh4, Hit, Isa, OriginBatch, Region, TraversalStats, VisitOrder};
 use crate::math::Ray;
 
 /// Fewer rays than this sharing a [`PacketKey`] are traced one by one: a packet's walk costs about
@@ -187,11 +187,16 @@ impl Accel {
         if !batch.traverses() {
             return batch.occluded_lanes(dirs, tmax);
         }
-        self.occluded_from_origin(batch.origin(), dirs, tmax, live)
+        // The batch's thread learns which order of visits answers sooner.
+        batch.walk_in_order(
+            #[inline(always)]
+            |order| self.occluded_from_origin(batch.origin(), dirs, tmax, live, order),
+        )
     }
 
     /// [`WideBvh::occluded_from_origin`]: rays from one point, walked together where they share
-    /// nodes. Call it inside [`Accel::simd`], so that its loops over the rays get the ISA's width.
+    /// nodes, visiting children in `order`. Call it inside [`Accel::simd`], so that its loops over
+    /// the rays get the ISA's width.
     #[inline(always)]
     pub fn occluded_from_origin<const N: usize>(
         &self,
@@ -199,8 +204,9 @@ impl Accel {
         dirs: &[[f32; N]; 3],
         tmax: f32,
         live: u32,
+        order: VisitOrder,
     ) -> u32 {
-        with_bvh!(self, bvh => bvh.occluded_from_origin(origin, dirs, tmax, live))
+        with_bvh!(self, bvh => bvh.occluded_from_origin(origin, dirs, tmax, live, order))
     }
 
     /// [`Accel::occluded`] for a ray of a batch prepared with [`Accel::prepare_batch`].

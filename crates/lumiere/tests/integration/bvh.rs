@@ -4,7 +4,7 @@
 use crate::common::{TestRng, grid_cube};
 use glam::Vec3;
 use lumiere::accel::simd::portable::F32xN;
-use lumiere::accel::{Accel, BuildPreset, Bvh, Bvh4, Hit, Isa, TraversalStats, WideBvh};
+use lumiere::accel::{Accel, BuildPreset, Bvh, Bvh4, Hit, Isa, TraversalStats, VisitOrder, WideBvh};
 use lumiere::geometry::triangle::{WatertightRay, intersect_triangle, is_degenerate};
 use lumiere::math::{Frame, Ray};
 
@@ -398,8 +398,10 @@ fn rays_from_one_origin_walked_together_match_brute_force() {
             blocked_lanes += expected.count_ones();
             for accel in &accels {
                 let isa = accel.isa();
-                let blocked = accel.simd(|| accel.occluded_from_origin(origin, &dirs, tmax, live));
-                assert_eq!(blocked, expected, "mesh {mesh_index}: {isa} from {origin:?}, live {live:#x}");
+                for order in [VisitOrder::NearestFirst, VisitOrder::FarthestFirst] {
+                    let blocked = accel.simd(|| accel.occluded_from_origin(origin, &dirs, tmax, live, order));
+                    assert_eq!(blocked, expected, "mesh {mesh_index}: {isa} {order:?} from {origin:?}, live {live:#x}");
+                }
             }
         }
     }

@@ -9,8 +9,8 @@
 //! bunny's ambient occlusion); each triangle block is tested ray by ray, with
 //! the single-ray kernel, for the rays that reached it. A subtree that few rays entered is left to
 //! the single-ray walk, whose test takes a node's `W` boxes in one vector. Children are visited
-//! nearest to the origin first: rays from a point meet nearer boxes first, whatever their
-//! directions, and one distance per child serves them all.
+//! nearest to the origin first, or farthest first (`accel/visit_order.rs` chooses): one distance
+//! per child serves all the rays, whatever their directions.
 //!
 //! Unlike [`super::RayPacket`], the rays need not share their direction signs: the origin is
 //! common, so each box plane minus the origin is one number for all rays, and each lane picks its
@@ -26,9 +26,9 @@ use super::leaf::{self, LEAF_BIT};
 use super::node::{EMPTY_CHILD, WideNode};
 use super::traverse::{BoxRay, Stack};
 use super::triangles::{TriangleRay, intersect_block};
-use crate::accel::TraversalStats;
 use crate::accel::simd::{LaneMask, Lanes, lanes_of, max_ps};
 use crate::accel::slab::{BOX_EXPANSION, PRUNE_SLACK, safe_reciprocal};
+use crate::accel::{TraversalStats, VisitOrder};
 use crate::geometry::triangle::WatertightRay;
 use crate::math::Ray;
 
@@ -95,8 +95,8 @@ fn distances_from<const W: usize>(node: &WideNode<W>, origin: &[f32; 3]) -> [f32
 // Inlined into the caller, which runs it in its ISA's `Accel::simd`.
 impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
     /// Which of the `live` rays (bit `i` for ray `i`) among `N <= 32` leaving `origin` with the
-    /// directions `dirs` (SoA) and one `tmax` are blocked, as [`WideBvh::occluded`] answers each;
-    /// bits outside `live` are 0.
+    /// directions `dirs` (SoA) and one `tmax` are blocked, as [`WideBvh::occluded`] answers each
+    /// (bits outside `live` are 0), visiting children in `order`.
     #[inline(always)]
     pub fn occluded_from_origin<const N: usize>(
         &self,
@@ -104,6 +104,7 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
         dirs: &[[f32; N]; 3],
         tmax: f32,
         live: u32,
+        order: VisitOrder,
     ) -> u32 {
         const { assert!(N <= 32, "a lane mask is a u32") };
         if live == 0 {
@@ -140,6 +141,7 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
                         &box_ray,
                         &TriangleRay::<L>::splat::<W>(triangle_rays[lane]),
                         tmax,
+                        order,
                         stats,
                         |_, _, _| true,
                     );
@@ -157,12 +159,15 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
                 }
                 continue;
             }
-            // The children some ray enters, nearest last, so that it is popped first.
+            // The children some ray enters, the first to visit last, so that it is popped first.
             let node = &self.nodes[reference as usize];
             let distances = distances_from(node, &rays.origin);
+            // Sorted by key, least key last: the distance, or farthest first its negation (an
+            // empty slot's NaN is skipped either way).
+            let keys = if order == VisitOrder::FarthestFirst { distances.map(|d| -d) } else { distances };
             let mut children = [(0u32, 0u32, 0f32); W];
             let mut count = 0;
-            for (slot, &distance) in distances.iter().enumerate() {
+            for (slot, (&distance, &key)) in distances.iter().zip(&keys).enumerate() {
                 let child = node.children[slot];
                 if child == EMPTY_CHILD {
                     continue;
@@ -174,11 +179,11 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
                     continue;
                 }
                 let mut i = count;
-                while i > 0 && children[i - 1].2 < distance {
+                while i > 0 && children[i - 1].2 < key {
                     children[i] = children[i - 1];
                     i -= 1;
                 }
-                children[i] = (child, mask, distance);
+                children[i] = (child, mask, key);
                 count += 1;
             }
             for &(child, mask, _) in &children[..count] {
