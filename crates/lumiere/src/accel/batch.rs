@@ -23,15 +23,12 @@
 //! rays per origin, a hemisphere in a large scene) or the region holds too many triangles, the
 //! batch falls back to ordinary traversal for each ray.
 
-use std::cell::Cell;
 use std::mem::MaybeUninit;
-use std::time::Instant;
 
 use glam::{Vec3, Vec4};
 
 use super::bvh2::MAX_DEPTH;
 use super::simd::{F32x4, LaneMask, Lanes, all_lanes, min_ps};
-use super::visit_order::{OrderChooser, VisitOrder};
 use super::wide::{LEAF_BIT, TriangleBlock, WideBvh, leaf_blocks};
 use crate::math::{Frame, Ray};
 
@@ -271,12 +268,6 @@ pub struct OriginBatch {
     traverse: bool,
 }
 
-thread_local! {
-    /// The order in which this thread's walks visit the BVH's children, learnt from its walks,
-    /// tile after tile (a batch lives for one tile of 256 pixels: too few walks to learn from).
-    static VISIT_ORDER: Cell<OrderChooser> = Cell::new(OrderChooser::default());
-}
-
 impl OriginBatch {
     /// Gathers the triangles of `bvh` that may block `rays` rays from `origin` within `region`, or
     /// decides up front that per-ray traversal will be cheaper (too few rays, too large a region).
@@ -450,20 +441,6 @@ impl OriginBatch {
     /// Whether rays of this batch are traced one by one through the BVH (no candidates gathered).
     pub fn traverses(&self) -> bool {
         self.traverse
-    }
-
-    /// `walk(order)` in the order of visits this thread's walks are to take next, timed when it
-    /// is one of the trials that choose the order (see `visit_order.rs`). `walk` is called from
-    /// one place, so that it is inlined into the caller's ISA (an intrinsic out of line is a call).
-    #[inline(always)]
-    pub fn walk_in_order<R>(&self, walk: impl FnOnce(VisitOrder) -> R) -> R {
-        let mut chooser = VISIT_ORDER.get();
-        let order = chooser.next();
-        let start = chooser.is_trial().then(Instant::now);
-        let result = walk(order);
-        chooser.record(order, start.map_or(0, |start| start.elapsed().as_nanos() as u64));
-        VISIT_ORDER.set(chooser);
-        result
     }
 
     /// Candidate blocks gathered, and whether rays fall back to traversal (for tests and tuning).

@@ -11,7 +11,7 @@ use super::bvh2::{BuildPreset, Bvh};
 use super::simd::lanes_of;
 use super::simd::portable::F32xN;
 use super::wide::{PacketKey, RayPacket, WideBvh};
-use super::{Bvh4, Hit, Isa, OriginBatch, Region, TraversalStats, VisitOrder};
+use super::{Bvh4, Hit, Isa, OriginBatch, Region, TraversalStats, VisitOrder, visit_order};
 use crate::math::Ray;
 
 /// Fewer rays than this sharing a [`PacketKey`] are traced one by one: a packet's walk costs about
@@ -187,8 +187,8 @@ impl Accel {
         if !batch.traverses() {
             return batch.occluded_lanes(dirs, tmax);
         }
-        // The batch's thread learns which order of visits answers sooner.
-        batch.walk_in_order(
+        // Each thread learns which order of visits answers sooner.
+        visit_order::in_learnt_order(
             #[inline(always)]
             |order| self.occluded_from_origin(batch.origin(), dirs, tmax, live, order),
         )

@@ -21,7 +21,7 @@ pub use batch::{OriginBatch, Region};
 pub use bvh2::{BuildPreset, Bvh, Node};
 pub use dispatch::Accel;
 pub use simd::Isa;
-pub use visit_order::{OrderChooser, VisitOrder};
+pub use visit_order::VisitOrder;
 pub use wide::{TriangleBlock, WideBvh, WideNode};
 
 /// The 4-wide layout with the SSE kernel (the x86-64 baseline; the portable kernel elsewhere):

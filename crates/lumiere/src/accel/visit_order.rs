@@ -19,6 +19,9 @@
 //! staircase from 0.20 to 0.96, a median of 0.48. The image never depends on the choice: every
 //! order gives every ray's own answer.
 
+use std::cell::Cell;
+use std::time::Instant;
+
 /// The order of a walk's visits among the children its rays enter.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum VisitOrder {
@@ -36,9 +39,29 @@ const TRIALS: u32 = 32;
 /// Farthest first is chosen when its trials took less than this fraction of nearest first's.
 const FARTHEST_IF_BELOW: f64 = 0.7;
 
+thread_local! {
+    /// This thread's choice, learnt from its walks tile after tile (a tile of 16x16 pixels is too
+    /// few walks to learn from: trials were an eighth of them).
+    static CHOOSER: Cell<OrderChooser> = Cell::new(OrderChooser::default());
+}
+
+/// `walk(order)` in the order this thread's walks take next, timed when it is one of the trials
+/// that choose it. `walk` is called from one place, so that it is inlined into the caller's ISA
+/// (an intrinsic out of line becomes a call).
+#[inline(always)]
+pub fn in_learnt_order<R>(walk: impl FnOnce(VisitOrder) -> R) -> R {
+    let mut chooser = CHOOSER.get();
+    let order = chooser.next();
+    let start = chooser.is_trial().then(Instant::now);
+    let result = walk(order);
+    chooser.record(order, start.map_or(0, |start| start.elapsed().as_nanos() as u64));
+    CHOOSER.set(chooser);
+    result
+}
+
 /// A thread's choice of [`VisitOrder`]: what it tries or uses next, and what its trials cost.
 #[derive(Clone, Copy, Debug)]
-pub struct OrderChooser {
+struct OrderChooser {
     /// Walks so far.
     walks: u32,
     /// The time the trials of this epoch took, per order (any unit).
@@ -55,7 +78,7 @@ impl Default for OrderChooser {
 impl OrderChooser {
     /// The order of the next walk.
     #[inline]
-    pub fn next(&self) -> VisitOrder {
+    fn next(&self) -> VisitOrder {
         let k = self.walks % EPOCH;
         if k >= TRIALS {
             self.chosen
@@ -68,14 +91,14 @@ impl OrderChooser {
 
     /// Whether the next walk is a trial, whose time [`OrderChooser::record`] needs.
     #[inline]
-    pub fn is_trial(&self) -> bool {
+    fn is_trial(&self) -> bool {
         self.walks % EPOCH < TRIALS
     }
 
     /// Records the walk [`OrderChooser::next`] ordered, and the time it took if it was a trial
     /// (ignored otherwise).
     #[inline]
-    pub fn record(&mut self, order: VisitOrder, cost: u64) {
+    fn record(&mut self, order: VisitOrder, cost: u64) {
         let k = self.walks % EPOCH;
         if k < TRIALS {
             self.trial_costs[order as usize] += cost;
