@@ -31,6 +31,18 @@ pub enum VisitOrder {
     FarthestFirst,
 }
 
+impl VisitOrder {
+    /// Sort keys of children at `distances` from the origin (or entry distances along a ray): the
+    /// child of the least key is visited first.
+    #[inline(always)]
+    pub(super) fn keys<const W: usize>(self, distances: [f32; W]) -> [f32; W] {
+        match self {
+            VisitOrder::NearestFirst => distances,
+            VisitOrder::FarthestFirst => distances.map(|d| -d),
+        }
+    }
+}
+
 /// Walks per epoch (a walk per pixel and pass: sixteen tiles of 16x16 pixels): a fresh choice this
 /// often follows the parts of the scene a thread moves across.
 const EPOCH: u32 = 4096;

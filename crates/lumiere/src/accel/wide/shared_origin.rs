@@ -162,9 +162,8 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
             // The children some ray enters, the first to visit last, so that it is popped first.
             let node = &self.nodes[reference as usize];
             let distances = distances_from(node, &rays.origin);
-            // Sorted by key, least key last: the distance, or farthest first its negation (an
-            // empty slot's NaN is skipped either way).
-            let keys = if order == VisitOrder::FarthestFirst { distances.map(|d| -d) } else { distances };
+            // Sorted by key, least key last (an empty slot's NaN is skipped either way).
+            let keys = order.keys(distances);
             let mut children = [(0u32, 0u32, 0f32); W];
             let mut count = 0;
             for (slot, (&distance, &key)) in distances.iter().zip(&keys).enumerate() {

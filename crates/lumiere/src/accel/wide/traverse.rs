@@ -261,9 +261,7 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
                 }
                 let node = &self.nodes[reference as usize];
                 let (mask, nears) = box_ray.enter(node, tmax_lanes);
-                // `push_children` visits the least key first.
-                let keys = if order == VisitOrder::FarthestFirst { nears.map(|near| -near) } else { nears };
-                if let Some(next) = push_children(node, mask, &keys, &mut stack) {
+                if let Some(next) = push_children(node, mask, &order.keys(nears), &mut stack) {
                     current = next;
                     continue;
                 }
@@ -276,7 +274,8 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
     }
 }
 
-/// Pushes the entered children but the nearest, farthest first, and returns the nearest to visit next.
+/// Pushes the entered children but the one of least key (entry distance, or a [`VisitOrder`]'s
+/// key for it), greatest key first, and returns the least to visit next.
 #[inline(always)]
 fn push_children<const W: usize>(
     node: &WideNode<W>,
