@@ -31,6 +31,8 @@
 //! receiver's visible weights are summed lane by lane, then times `f Le`, instead of each
 //! contribution added in sample order. At 256x192 the PFMs of `--samples 16`, `64` and `3 --spp
 //! 4` differ from the old ones by at most 7.8e-7 relative (rounding), the PNGs not at all.
+//! Then `direct-wide` joined, its hashes those of the binary before the batches' groups of 32
+//! rays, so that it checks that a group of 32 adds its samples' weights as two groups of 16 did.
 
 use std::process::Command;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -79,7 +81,7 @@ fn hashes_of(name: &str, scene_args: &[&str], args: &[&str]) -> (u64, u64) {
 type Case = (&'static str, &'static [&'static str], u64, u64);
 
 #[rustfmt::skip]
-const CASES: [Case; 12] = [
+const CASES: [Case; 13] = [
         ("hits", &["--mode", "hits"], 0xe5be6fadb7d0387a, 0x7d3cdc4ae8c8cc5c),
         ("materials", &["--mode", "materials"], 0xdadcc58aa85add45, 0x03b4ff564eb04fcc),
         ("shadows", &["--mode", "shadows"], 0x76e28bae8e2de7eb, 0x723af1f9843debe7),
@@ -104,6 +106,8 @@ const CASES: [Case; 12] = [
         ("ao-batch", &["--mode", "ao", "--samples", "40"], 0xd2a414dc4d239e2c, 0x7382b930850240ea),
         ("ao-batch-near", &["--mode", "ao", "--samples", "33", "--spp", "2", "--ao-distance", "0.3"], 0x140520f276826a14, 0xc7c8652cc1a07a34),
         ("direct-batch", &["--mode", "direct", "--samples", "16"], 0x659adb5d42622794, 0x6d973776a2f02a12),
+        // A group of 32 shadow rays per light, then one of 16 (8 of them live).
+        ("direct-wide", &["--mode", "direct", "--samples", "40"], 0x12cdc2aea2482d48, 0x1ab2b3bd5ae010db),
         // Enough probes per point for a batch per quarter of the hemisphere.
         ("ao-quarters", &["--mode", "ao", "--samples", "256"], 0x2ef61a1287131e64, 0xf4de07707fc3cc07),
 ];

@@ -52,18 +52,30 @@ impl<B: Bsdf> Receiver<'_, B> {
     }
 }
 
-/// Shadow rays drawn and tested together: one AVX-512 register of f32 (two AVX2 ones).
-const LANES: usize = 16;
+/// A group of one light's samples: `first..` of the `n`, for a diffuse receiver or another.
+struct Group {
+    light: u32,
+    first: u32,
+    n: u32,
+    diffuse: bool,
+}
+
+/// Shadow rays drawn and tested together: two AVX-512 registers of f32 (four AVX2 ones) while a
+/// light has that many samples left, then one (as ambient occlusion's probes, and for the same
+/// reasons).
+const WIDE: usize = 32;
+const NARROW: usize = 16;
 
 impl<B: Bsdf> Receiver<'_, B> {
     /// `sum` plus `f Le V cos(theta) / pdf` of each of the `n` points of `light` drawn from
-    /// `points`, `LANES` at a time: their contributions are computed lane by lane and their shadow
-    /// segments tested together against the batch (prepared for the shaft to the light).
+    /// `points`, [`WIDE`] or [`NARROW`] at a time: their contributions are computed lane by lane
+    /// and their shadow segments tested together against the batch (prepared for the shaft to the
+    /// light).
     ///
     /// A diffuse receiver's contributions are `f Le` times a weight `cos(theta) / pdf`: the
-    /// visible weights are added up lane by lane (sample `k` into lane `k % LANES`, in sample
-    /// order), the lanes then in lane order, and `f Le` times that total is added to `sum`, the
-    /// same additions on every ISA. (Adding each visible contribution to `sum` in sample order, a
+    /// visible weights are added up in `NARROW` sums (sample `k` into sum `k % NARROW`, in sample
+    /// order, whatever the groups' widths), the sums then in order, and `f Le` times that total is
+    /// added to `sum`: the same additions on every ISA. (Adding each visible contribution to `sum` in sample order, a
     /// chain of dependent scalar additions, was a tenth of a soft-shadow render.) Other receivers
     /// add their visible contributions to `sum` in sample order.
     #[inline(always)]
@@ -79,44 +91,74 @@ impl<B: Bsdf> Receiver<'_, B> {
         ctx: &mut SampleContext,
     ) -> Vec3 {
         let lights = world.lights();
-        let origin = batch.origin();
         let lambertian = self.bsdf.lambertian_eval(self.wo);
         if lambertian == Some(Vec3::ZERO) {
             // A zero BSDF: `unshadowed` refuses every sample, no ray is traced.
             return sum;
         }
         let area_light = &lights.lights()[light as usize];
-        let mut lane_weights = [0.0f32; LANES];
-        for first in (0..n).step_by(LANES) {
-            // Polled as often as one sample at a time polled it (every `STOP_POLL` samples).
-            if ctx.must_stop(first + LANES as u32 - 1) {
+        let mut weight_sums = [0.0f32; NARROW];
+        let mut first = 0;
+        while first < n {
+            // Polled as often as one sample at a time polled it (every `STOP_POLL` samples): every
+            // group but the last starts at a multiple of `WIDE`.
+            if ctx.must_stop(first + WIDE as u32 - 1) {
                 break;
             }
-            let count = (n - first).min(LANES as u32) as usize;
-            let points: [Vec2; LANES] = points.get_2d_lanes(first);
-            if lambertian.is_some() {
-                let (weights, segments, traced) = self.lambertian_lanes(area_light, &points, count, origin);
-                let visible = trace(world, batch, &segments, traced, ctx);
-                // All ones for a visible lane, else zero: the weights are masked bitwise (an
-                // unlit lane's may be infinite or NaN, which a product by 0 would keep).
-                for lane in 0..LANES {
-                    let keep = 0u32.wrapping_sub((visible >> lane) & 1);
-                    lane_weights[lane] += f32::from_bits(weights[lane].to_bits() & keep);
-                }
+            let group = Group { light, first, n, diffuse: lambertian.is_some() };
+            if n - first >= WIDE as u32 {
+                sum = self.add_group::<WIDE>(sum, world, points, &group, batch, &mut weight_sums, ctx);
+                first += WIDE as u32;
             } else {
-                let (contributions, segments, traced) = self.bsdf_lanes(lights, light, &points, count, origin);
-                for lane in lanes_of(trace(world, batch, &segments, traced, ctx)) {
-                    sum += contributions[lane];
-                }
+                sum = self.add_group::<NARROW>(sum, world, points, &group, batch, &mut weight_sums, ctx);
+                first += NARROW as u32;
             }
         }
         match lambertian {
             Some(f) => {
-                let total = lane_weights.iter().fold(0.0, |total, &weight| total + weight);
+                let total = weight_sums.iter().fold(0.0, |total, &weight| total + weight);
                 sum + f * area_light.emission * total
             }
             None => sum,
         }
+    }
+
+    /// [`Receiver::add_light`]'s samples `group.first..group.first + N` (those below `group.n`):
+    /// a diffuse receiver's visible weights added to `weight_sums`, another's visible
+    /// contributions to `sum`.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn add_group<const N: usize>(
+        &self,
+        mut sum: Vec3,
+        world: &World,
+        points: &PointSet,
+        group: &Group,
+        batch: &OriginBatch,
+        weight_sums: &mut [f32; NARROW],
+        ctx: &mut SampleContext,
+    ) -> Vec3 {
+        let count = (group.n - group.first).min(N as u32) as usize;
+        let points: [Vec2; N] = points.get_2d_lanes(group.first);
+        if group.diffuse {
+            let area_light = &world.lights().lights()[group.light as usize];
+            let (weights, segments, traced) = self.lambertian_lanes(area_light, &points, count, batch.origin());
+            let visible = trace(world, batch, &segments, traced, ctx);
+            // All ones for a visible lane, else zero: the weights are masked bitwise (an unlit
+            // lane's may be infinite or NaN, which a product by 0 would keep). Lane `k` is sample
+            // `first + k`, and `first` is a multiple of `NARROW`.
+            for lane in 0..N {
+                let keep = 0u32.wrapping_sub((visible >> lane) & 1);
+                weight_sums[lane % NARROW] += f32::from_bits(weights[lane].to_bits() & keep);
+            }
+        } else {
+            let (contributions, segments, traced) =
+                self.bsdf_lanes(world.lights(), group.light, &points, count, batch.origin());
+            for lane in lanes_of(trace(world, batch, &segments, traced, ctx)) {
+                sum += contributions[lane];
+            }
+        }
+        sum
     }
 }
 
@@ -126,20 +168,20 @@ impl<B: Bsdf> Receiver<'_, B> {
     /// loops: the light points (plain arithmetic, vectorised), then the BSDF, a call per lane,
     /// which would keep the points scalar if they shared its loop.
     #[inline(always)]
-    fn bsdf_lanes(
+    fn bsdf_lanes<const N: usize>(
         &self,
         lights: &LightSet,
         light: u32,
-        points: &[Vec2; LANES],
+        points: &[Vec2; N],
         count: usize,
         origin: Vec3,
-    ) -> ([Vec3; LANES], [[f32; LANES]; 3], u32) {
-        let mut samples = [None; LANES];
+    ) -> ([Vec3; N], [[f32; N]; 3], u32) {
+        let mut samples = [None; N];
         for (sample, &u) in samples.iter_mut().zip(points) {
             *sample = lights.sample_li_on(light, self.surface.p, u).filter(|s| self.faces(s));
         }
-        let mut contributions = [Vec3::ZERO; LANES];
-        let mut segments = [[0.0; LANES]; 3];
+        let mut contributions = [Vec3::ZERO; N];
+        let mut segments = [[0.0; N]; 3];
         let mut traced = 0u32;
         for (lane, sample) in samples.iter().enumerate().take(count) {
             let Some(sample) = sample else { continue };
@@ -159,18 +201,18 @@ impl<B: Bsdf> Receiver<'_, B> {
     /// `shadow_target`, `sample_li_on`, `faces` and `unshadowed` in their order (glam's `dot` and
     /// `length_squared` sum x, y, then z), so its segment and weight have their bits.
     #[inline(always)]
-    fn lambertian_lanes(
+    fn lambertian_lanes<const N: usize>(
         &self,
         light: &AreaLight,
-        points: &[Vec2; LANES],
+        points: &[Vec2; N],
         count: usize,
         origin: Vec3,
-    ) -> ([f32; LANES], [[f32; LANES]; 3], u32) {
+    ) -> ([f32; N], [[f32; N]; 3], u32) {
         let [p0, p1, p2] = light.shadow_targets.map(|t| t.to_array());
         let (p, o) = (self.surface.p.to_array(), origin.to_array());
         let (ns, ng, normal) = (self.surface.ns, self.surface.ng, light.normal);
-        let mut weights = [0.0f32; LANES];
-        let mut segments = [[0.0; LANES]; 3];
+        let mut weights = [0.0f32; N];
+        let mut segments = [[0.0; N]; 3];
         let mut traced = 0u32;
         for (lane, u) in points.iter().enumerate() {
             let s = u.x.sqrt();
@@ -212,10 +254,10 @@ impl<B> Receiver<'_, B> {
 /// Traces the `traced` shadow segments of a group of light points (from the batch's origin, ending
 /// at `t = 1`, SoA) against the batch, counting them; the lanes that reach the light.
 #[inline(always)]
-fn trace(
+fn trace<const N: usize>(
     world: &World,
     batch: &OriginBatch,
-    segments: &[[f32; LANES]; 3],
+    segments: &[[f32; N]; 3],
     traced: u32,
     ctx: &mut SampleContext,
 ) -> u32 {
