@@ -313,7 +313,10 @@ impl ShadesClosestHit for Direct {
                         });
                         batch_quad = quad_shaft.map(|(q, _)| q);
                         let shaft = quad_shaft.map(|(_, shaft)| shaft);
-                        let Some(shaft) = shaft.or_else(|| Region::shaft(origin, light.shadow_targets)) else {
+                        let shaft = shaft.or_else(|| Region::shaft(origin, light.shadow_targets));
+                        // Cut by the surface: every traced segment leaves above it (samples below
+                        // `ng` are skipped), so the receiver's own triangles cannot block one.
+                        let Some(shaft) = shaft.map(|shaft| shaft.above(origin, surface.ng)) else {
                             continue;
                         };
                         world.prepare_batch(&mut batch, origin, &shaft, n);

@@ -408,6 +408,59 @@ fn rays_from_one_origin_walked_together_match_brute_force() {
     assert!(blocked_lanes > 300, "only {blocked_lanes} lanes blocked: the test asks too little");
 }
 
+/// A shaft from a floor to a light above, cut by the floor's plane (`Region::above`): the floor's
+/// own triangles, which the shaft's sides keep where they meet at the origin, are left out, and
+/// every segment to the light answers as in the whole shaft, and as brute force does.
+#[test]
+fn shafts_cut_by_the_surface_leave_out_the_receiver_and_answer_the_same() {
+    use lumiere::accel::{OriginBatch, Region};
+    use lumiere::math::offset_ray_origin;
+    // A floor of 4x4 quads at y = 0 over [-2, 2]², a blocker at y = 1, a light triangle at y = 2.
+    let (mut positions, mut indices) = (Vec::new(), Vec::new());
+    for i in 0..4 {
+        for j in 0..4 {
+            let (x, z) = (i as f32 - 2.0, j as f32 - 2.0);
+            let base = positions.len() as u32;
+            positions.extend([
+                Vec3::new(x, 0.0, z),
+                Vec3::new(x + 1.0, 0.0, z),
+                Vec3::new(x + 1.0, 0.0, z + 1.0),
+                Vec3::new(x, 0.0, z + 1.0),
+            ]);
+            indices.extend([[base, base + 1, base + 2], [base, base + 2, base + 3]]);
+        }
+    }
+    let base = positions.len() as u32;
+    positions.extend([Vec3::new(-0.6, 1.0, -0.4), Vec3::new(0.5, 1.0, -0.3), Vec3::new(0.0, 1.0, 0.7)]);
+    indices.push([base, base + 1, base + 2]);
+    let light = [Vec3::new(-0.5, 2.0, -0.5), Vec3::new(0.5, 2.0, -0.5), Vec3::new(0.0, 2.0, 0.5)];
+    let wide = Bvh4::from_binary(&Bvh::build(&positions, &indices, BuildPreset::Default));
+    let mut rng = TestRng(31);
+    let (mut whole, mut cut) = (OriginBatch::default(), OriginBatch::default());
+    let (mut blocked, mut visible) = (0, 0);
+    for _ in 0..40 {
+        let p = Vec3::new(rng.range(-1.9, 1.9), 0.0, rng.range(-1.9, 1.9));
+        let origin = offset_ray_origin(p, Vec3::Y);
+        let shaft = Region::shaft(origin, light).expect("the light is above the floor");
+        whole.prepare(&wide, origin, &shaft, 64);
+        cut.prepare(&wide, origin, &shaft.above(origin, Vec3::Y), 64);
+        let (whole_blocks, cut_blocks) = (whole.candidate_blocks().unwrap(), cut.candidate_blocks().unwrap());
+        // The floor's triangles around the origin fill a block of their own; the blocker, where
+        // the shaft meets it, the only other.
+        assert!(cut_blocks <= 1 && cut_blocks < whole_blocks, "{whole_blocks} blocks -> {cut_blocks} from {origin:?}");
+        for _ in 0..64 {
+            let (a, b) = (rng.f32(), rng.f32());
+            let (a, b) = if a + b > 1.0 { (1.0 - a, 1.0 - b) } else { (a, b) };
+            let ray = Ray::segment(origin, light[0] + a * (light[1] - light[0]) + b * (light[2] - light[0]));
+            let expected = brute_force(&positions, &indices, &ray).is_some();
+            assert_eq!(cut.occluded(&wide, &ray), expected, "{ray:?}");
+            assert_eq!(whole.occluded(&wide, &ray), expected, "{ray:?}");
+            if expected { blocked += 1 } else { visible += 1 }
+        }
+    }
+    assert!(blocked > 200 && visible > 200, "{blocked} blocked, {visible} visible: the test asks too little");
+}
+
 /// A closed mesh seen from inside: no batched ray escapes, through vertices and edges included.
 #[test]
 fn origin_batches_never_leak_through_a_closed_mesh() {
