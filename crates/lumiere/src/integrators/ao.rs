@@ -2,7 +2,7 @@ use std::ops::Range;
 
 use glam::{Vec2, Vec3};
 
-use super::{SampleContext, ShadesClosestHit};
+use super::{NARROW_GROUP, SampleContext, ShadesClosestHit, WIDE_GROUP};
 use crate::accel::Hit;
 use crate::accel::{OriginBatch, Region};
 use crate::math::{Frame, Ray};
@@ -25,20 +25,13 @@ pub struct AmbientOcclusion {
     pub distance: f32,
 }
 
-/// Probes drawn and tested together: two AVX-512 registers of f32 (four AVX2 ones) while a range
-/// has that many left, then one. Twice the rays per broadcast triangle or walked node, and two
-/// independent chains of sine and cosine polynomials: against sixteen at a time (1 thread), the
-/// Cornell box at N = 256 (four batches of 64) 13% faster, the 1.1M-triangle bunny (walked) 8%;
-/// sixteen probes per point in groups of 32, half of them idle, were 32% slower.
-const WIDE: usize = 32;
-const NARROW: usize = 16;
-
 /// From this many probes per point, each quarter of the hemisphere has candidates of its own,
 /// gathered together in one walk: a quarter of the Cornell box's hemispheres holds 3.2 blocks of
 /// four triangles on average against 7.4 for the whole, so each probe is tested against less than
 /// half as many triangles. Fewer probes do not pay for the quarters' partly filled groups of
-/// `NARROW`. Measured on the Cornell box (1024x768, 2 threads, alternating, medians of 5), quarters
-/// from 16 probes on against from 256 on: 128 probes 488 -> 438 ms, 64: 292 -> 298, 16: 139 -> 306.
+/// `NARROW_GROUP`. Measured on the Cornell box (1024x768, 2 threads, alternating, medians of 5),
+/// quarters from 16 probes on against from 256 on: 128 probes 488 -> 438 ms, 64: 292 -> 298, 16:
+/// 139 -> 306; with groups of 32, quarters from 64 probes on were slower again (653 -> 673 ms).
 const MIN_QUARTER_BATCH: u32 = 128;
 
 impl ShadesClosestHit for AmbientOcclusion {
@@ -84,7 +77,8 @@ impl AmbientOcclusion {
         self.samples.is_multiple_of(4).then(|| [0, quarter, 2 * quarter, 3 * quarter, self.samples])
     }
 
-    /// How many of the probes `probes` reach the sky, [`WIDE`] or [`NARROW`] at a time.
+    /// How many of the probes `probes` reach the sky, [`WIDE_GROUP`] or [`NARROW_GROUP`] at a
+    /// time.
     #[inline(always)]
     fn count_visible(
         &self,
@@ -99,17 +93,18 @@ impl AmbientOcclusion {
         let mut first = probes.start;
         while first < probes.end {
             // Polled about as often as one probe at a time polled it (every `STOP_POLL` probes):
-            // one group of `WIDE` starts in each `WIDE` probes before a multiple of `STOP_POLL`.
-            if ctx.must_stop(first / WIDE as u32 * WIDE as u32 + WIDE as u32 - 1) {
+            // a quarter's probes start anywhere, so `first` is rounded down to a multiple of
+            // `WIDE_GROUP`, and each `WIDE_GROUP` probes hold one group that polls.
+            if ctx.must_stop(first / WIDE_GROUP as u32 * WIDE_GROUP as u32 + WIDE_GROUP as u32 - 1) {
                 break;
             }
             let left = probes.end - first;
-            if left >= WIDE as u32 {
-                visible += self.count_visible_in_group::<WIDE>(world, batch, frame, directions, first, left);
-                first += WIDE as u32;
+            if left >= WIDE_GROUP as u32 {
+                visible += self.count_visible_in_group::<WIDE_GROUP>(world, batch, frame, directions, first, left);
+                first += WIDE_GROUP as u32;
             } else {
-                visible += self.count_visible_in_group::<NARROW>(world, batch, frame, directions, first, left);
-                first += NARROW as u32;
+                visible += self.count_visible_in_group::<NARROW_GROUP>(world, batch, frame, directions, first, left);
+                first += NARROW_GROUP as u32;
             }
         }
         visible

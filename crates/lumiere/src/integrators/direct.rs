@@ -1,6 +1,6 @@
 use glam::{Vec2, Vec3};
 
-use super::{SampleContext, ShadesClosestHit, shading_frame};
+use super::{NARROW_GROUP, SampleContext, ShadesClosestHit, WIDE_GROUP, shading_frame};
 use crate::accel::simd::lanes_of;
 use crate::accel::{Hit, OriginBatch, Region};
 use crate::geometry::surface::SurfacePoint;
@@ -60,24 +60,19 @@ struct Group {
     diffuse: bool,
 }
 
-/// Shadow rays drawn and tested together: two AVX-512 registers of f32 (four AVX2 ones) while a
-/// light has that many samples left, then one (as ambient occlusion's probes, and for the same
-/// reasons).
-const WIDE: usize = 32;
-const NARROW: usize = 16;
-
 impl<B: Bsdf> Receiver<'_, B> {
     /// `sum` plus `f Le V cos(theta) / pdf` of each of the `n` points of `light` drawn from
-    /// `points`, [`WIDE`] or [`NARROW`] at a time: their contributions are computed lane by lane
-    /// and their shadow segments tested together against the batch (prepared for the shaft to the
-    /// light).
+    /// `points`, [`WIDE_GROUP`] or [`NARROW_GROUP`] at a time: their contributions are computed
+    /// lane by lane and their shadow segments tested together against the batch (prepared for the
+    /// shaft to the light).
     ///
     /// A diffuse receiver's contributions are `f Le` times a weight `cos(theta) / pdf`: the
-    /// visible weights are added up in `NARROW` sums (sample `k` into sum `k % NARROW`, in sample
-    /// order, whatever the groups' widths), the sums then in order, and `f Le` times that total is
-    /// added to `sum`: the same additions on every ISA. (Adding each visible contribution to `sum` in sample order, a
-    /// chain of dependent scalar additions, was a tenth of a soft-shadow render.) Other receivers
-    /// add their visible contributions to `sum` in sample order.
+    /// visible weights are added up in `NARROW_GROUP` sums (sample `k` into sum
+    /// `k % NARROW_GROUP`, in sample order, whatever the groups' widths), the sums then in order,
+    /// and `f Le` times that total is added to `sum`: the same additions on every ISA. (Adding
+    /// each visible contribution to `sum` in sample order, a chain of dependent scalar additions,
+    /// was a tenth of a soft-shadow render.) Other receivers add their visible contributions to
+    /// `sum` in sample order.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     fn add_light(
@@ -97,21 +92,23 @@ impl<B: Bsdf> Receiver<'_, B> {
             return sum;
         }
         let area_light = &lights.lights()[light as usize];
-        let mut weight_sums = [0.0f32; NARROW];
+        let mut weight_sums = [0.0f32; NARROW_GROUP];
         let mut first = 0;
         while first < n {
-            // Polled as often as one sample at a time polled it (every `STOP_POLL` samples): every
-            // group but the last starts at a multiple of `WIDE`.
-            if ctx.must_stop(first + WIDE as u32 - 1) {
+            // Polled as often as one sample at a time polled it (every `STOP_POLL` samples): each
+            // wide group starts at a multiple of `WIDE_GROUP`. (Rounding `first` down to one, as
+            // ambient occlusion's probes must, made soft shadows at N = 64 take 3,030 ms instead
+            // of 640, 1 thread: the compiler then builds this loop otherwise.)
+            if ctx.must_stop(first + WIDE_GROUP as u32 - 1) {
                 break;
             }
             let group = Group { light, first, n, diffuse: lambertian.is_some() };
-            if n - first >= WIDE as u32 {
-                sum = self.add_group::<WIDE>(sum, world, points, &group, batch, &mut weight_sums, ctx);
-                first += WIDE as u32;
+            if n - first >= WIDE_GROUP as u32 {
+                sum = self.add_group::<WIDE_GROUP>(sum, world, points, &group, batch, &mut weight_sums, ctx);
+                first += WIDE_GROUP as u32;
             } else {
-                sum = self.add_group::<NARROW>(sum, world, points, &group, batch, &mut weight_sums, ctx);
-                first += NARROW as u32;
+                sum = self.add_group::<NARROW_GROUP>(sum, world, points, &group, batch, &mut weight_sums, ctx);
+                first += NARROW_GROUP as u32;
             }
         }
         match lambertian {
@@ -135,7 +132,7 @@ impl<B: Bsdf> Receiver<'_, B> {
         points: &PointSet,
         group: &Group,
         batch: &OriginBatch,
-        weight_sums: &mut [f32; NARROW],
+        weight_sums: &mut [f32; NARROW_GROUP],
         ctx: &mut SampleContext,
     ) -> Vec3 {
         let count = (group.n - group.first).min(N as u32) as usize;
@@ -146,10 +143,10 @@ impl<B: Bsdf> Receiver<'_, B> {
             let visible = trace(world, batch, &segments, traced, ctx);
             // All ones for a visible lane, else zero: the weights are masked bitwise (an unlit
             // lane's may be infinite or NaN, which a product by 0 would keep). Lane `k` is sample
-            // `first + k`, and `first` is a multiple of `NARROW`.
+            // `first + k`, and `first` is a multiple of `NARROW_GROUP`.
             for lane in 0..N {
                 let keep = 0u32.wrapping_sub((visible >> lane) & 1);
-                weight_sums[lane % NARROW] += f32::from_bits(weights[lane].to_bits() & keep);
+                weight_sums[lane % NARROW_GROUP] += f32::from_bits(weights[lane].to_bits() & keep);
             }
         } else {
             let (contributions, segments, traced) =
