@@ -12,6 +12,7 @@ use crate::math::Ray;
 use crate::scene::Scene;
 use crate::scene::mesh::NO_INDEX;
 use crate::textures::{TextureId, TextureSet};
+use crate::util::memory::prefetch;
 
 pub struct World {
     scene: Scene,
@@ -33,7 +34,15 @@ pub struct World {
     warnings: Vec<String>,
     /// The diagonal of the scene's bounding box: no two of its points lie farther apart.
     diameter: f32,
+    /// Whether the records shading reads (the mesh's, the textures') outgrow a core's caches, so
+    /// that asking for them ahead ([`World::prefetch_hit`], [`World::prefetch_bsdf`]) pays:
+    /// where they all stay cached (the Cornell box), the requests only cost.
+    prefetches: bool,
 }
+
+/// The shading data above which [`World::prefetch_hit`] and [`World::prefetch_bsdf`] ask for
+/// anything: about a core's second-level cache.
+const PREFETCH_ABOVE_BYTES: usize = 1 << 20;
 
 impl World {
     /// Builds the BVH over the scene's triangles for the widest instruction set this CPU has,
@@ -56,6 +65,7 @@ impl World {
             TextureSet::for_cutouts(scene.materials.iter().map(|m| m.map_d.as_deref()));
         warnings.extend(cutout_warnings);
         let diameter = scene.bounds().extent().length();
+        let prefetches = scene.mesh.memory_bytes() + textures.memory_bytes() > PREFETCH_ABOVE_BYTES;
         World {
             scene,
             accel,
@@ -67,6 +77,7 @@ impl World {
             cutouts,
             warnings,
             diameter,
+            prefetches,
         }
     }
 
@@ -103,6 +114,39 @@ impl World {
             None => self.scene.materials[id].kd,
         };
         self.kinds[id].bsdf(base)
+    }
+
+    /// Starts loading the records of `hit`'s triangle that shading reads first (whether it is a
+    /// light; for [`World::surface`], its corners' indices and its material), so that other work
+    /// can run while they come from memory.
+    #[inline]
+    pub fn prefetch_hit(&self, hit: &Hit) {
+        if !self.prefetches {
+            return;
+        }
+        self.lights.prefetch_light_of(hit.triangle);
+        let mesh = &self.scene.mesh;
+        let id = hit.triangle as usize;
+        prefetch(&mesh.indices[id]);
+        prefetch(&mesh.material_ids[id]);
+        if let Some(corners) = mesh.normal_indices.get(id) {
+            prefetch(corners);
+        }
+        if let Some(corners) = mesh.texcoord_indices.get(id) {
+            prefetch(corners);
+        }
+    }
+
+    /// Starts loading what [`World::bsdf`] will read at `surface` (its texels), so that other work
+    /// can run while they come from memory.
+    #[inline]
+    pub fn prefetch_bsdf(&self, surface: &SurfacePoint) {
+        if !self.prefetches {
+            return;
+        }
+        if let Some(texture) = self.texture_of_material[surface.material as usize] {
+            self.textures.prefetch(texture, surface.uv);
+        }
     }
 
     /// The instruction set the BVH was built for.

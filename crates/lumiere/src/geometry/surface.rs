@@ -5,7 +5,7 @@ use glam::{Vec2, Vec3};
 use crate::math::{Ray, offset_ray_origin};
 
 /// What an integrator knows about a hit point.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SurfacePoint {
     /// Position, interpolated from the vertices (more accurate than `origin + t * dir`).
     pub p: Vec3,

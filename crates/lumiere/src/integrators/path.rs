@@ -13,11 +13,14 @@
 
 use glam::Vec3;
 
-use super::{Integrator, SampleContext};
+use super::{CameraPacket, Integrator, PACKET, SampleContext};
+use crate::accel::Hit;
+use crate::accel::simd::lanes_of;
 use crate::geometry::surface::SurfacePoint;
 use crate::lights::LightSelection;
 use crate::materials::{Bsdf, BsdfFlags};
 use crate::math::{Frame, Ray};
+use crate::sampler::SampleStream;
 use crate::sampling::mis::power_heuristic;
 use crate::world::World;
 
@@ -112,90 +115,192 @@ impl<B: Bsdf> Vertex<'_, B> {
     }
 }
 
-impl Integrator for Path {
-    fn radiance(&self, world: &World, camera_ray: &Ray, ctx: &mut SampleContext) -> Vec3 {
-        let lights = world.lights();
-        let mut radiance = Vec3::ZERO;
-        let mut throughput = Vec3::ONE;
-        // Unit directions from here on (BSDF samples are unit vectors): `wo` needs no
-        // normalisation, and a hit's `t` is its distance, which the light pdf of an emitter hit uses.
-        let mut ray = Ray::new(camera_ray.origin, camera_ray.dir.normalize());
-        // The previous vertex's BSDF density for the ray that left it (infinite for a delta lobe
-        // or the camera), for the MIS weight of the light that ray hits.
-        let mut previous_pdf = f32::INFINITY;
-        let mut depth = 0u32;
-        loop {
-            ctx.rays += 1;
-            let Some(hit) = world.intersect(&ray) else { break };
+/// One path in flight: where it goes next and what it has gathered.
+struct PathState<'a> {
+    ray: Ray,
+    throughput: Vec3,
+    radiance: Vec3,
+    /// The previous vertex's BSDF density for `ray` (infinite for a delta lobe or the camera), for
+    /// the MIS weight of the light `ray` hits.
+    previous_pdf: f32,
+    /// Segments traced so far.
+    depth: u32,
+    stream: SampleStream<'a>,
+}
 
-            // Emission: the light this ray found, weighted against having sampled it as a light.
-            if let Some(light) = lights.light_of(hit.triangle) {
-                let emitted = lights.lights()[light as usize].radiance_towards(-ray.dir);
-                if emitted != Vec3::ZERO {
-                    let weight = if previous_pdf.is_finite() {
-                        self.hit_weight(previous_pdf, lights.pdf_li(SELECTION, light, ray.dir, hit.t))
-                    } else {
-                        1.0
-                    };
-                    radiance += throughput * emitted * weight;
+/// A light sample a vertex found unblocked by its BSDF: what it adds if the segment is clear.
+struct ShadowTest {
+    segment: Ray,
+    contribution: Vec3,
+}
+
+impl Path {
+    /// The paths of up to `N` camera samples (bit `i` of `live` for lane `i`), traced in lockstep,
+    /// bounce by bounce: every live path's next closest hit, then every path's surface point, then
+    /// every path's scattering, then every shadow segment. Each path does exactly the operations,
+    /// in the order, it would do alone (light found at a vertex is added before the next vertex's),
+    /// so its radiance has the same bits however many travel together.
+    ///
+    /// Together, the records a path's shading reads are asked for a phase before they are used
+    /// (`World::prefetch_hit` after its hit, `World::prefetch_bsdf` after its surface point), and
+    /// come from memory while the other paths are worked on. On a large textured scene those
+    /// misses, at the end of a chain of dependent ones, were a fifth of the render: the staircase
+    /// takes 11% less time (the 1.1M-triangle bunny 21% less), and the Cornell box, whose records
+    /// stay cached, the same.
+    fn trace<'a, const N: usize>(
+        &self,
+        world: &World,
+        camera_rays: &[Ray; N],
+        streams: &[SampleStream<'a>; N],
+        mut live: u32,
+        rays: &mut u64,
+    ) -> [Vec3; N] {
+        let mut paths: [PathState<'a>; N] = std::array::from_fn(|lane| PathState {
+            // Unit directions from here on (BSDF samples are unit vectors): `wo` needs no
+            // normalisation, and a hit's `t` is its distance, which the light pdf of an emitter
+            // hit uses.
+            ray: Ray::new(camera_rays[lane].origin, camera_rays[lane].dir.normalize()),
+            throughput: Vec3::ONE,
+            radiance: Vec3::ZERO,
+            previous_pdf: f32::INFINITY,
+            depth: 0,
+            stream: streams[lane],
+        });
+        let mut shadows: [Option<ShadowTest>; N] = std::array::from_fn(|_| None);
+        let mut surfaces = [SurfacePoint::default(); N];
+        while live != 0 {
+            *rays += u64::from(live.count_ones());
+            let hits: [Option<Hit>; N] = std::array::from_fn(|lane| {
+                let hit = if live & (1 << lane) != 0 { world.intersect(&paths[lane].ray) } else { None };
+                if let Some(hit) = &hit {
+                    world.prefetch_hit(hit);
+                }
+                hit
+            });
+            for lane in lanes_of(live) {
+                match hits[lane] {
+                    Some(hit) if self.arrive(world, &mut paths[lane], &hit) => {
+                        surfaces[lane] = world.surface(&paths[lane].ray, &hit);
+                        world.prefetch_bsdf(&surfaces[lane]);
+                    }
+                    _ => live &= !(1 << lane),
                 }
             }
-            depth += 1;
-            if self.max_depth != 0 && depth >= self.max_depth {
-                break;
+            for lane in lanes_of(live) {
+                let (continues, shadow) = self.scatter(world, &mut paths[lane], &surfaces[lane]);
+                if !continues {
+                    live &= !(1 << lane);
+                }
+                shadows[lane] = shadow;
             }
-
-            let surface = world.surface(&ray, &hit);
-            let bsdf = world.bsdf(&surface);
-            // Opaque lobes scatter on the viewer's side, where `ns` is turned; a transmissive one
-            // needs its own orientation (`wo.z < 0` means inside), so its frame keeps the normal's.
-            let normal = if bsdf.transmits() && !surface.front_face { -surface.ns } else { surface.ns };
-            let frame = Frame::from_normal(normal);
-            let wo = frame.to_local(-ray.dir);
-            let vertex = Vertex { surface: &surface, bsdf, frame, wo };
-            // Each vertex takes three dimensions, whether it uses them or not, so that a bounce's
-            // numbers do not depend on the vertices before it; a dimension not used is not computed.
-            let (light_point, scatter_point, survival) =
-                (ctx.stream.next_points(1), ctx.stream.next_points(1), ctx.stream.next_points(1));
-
-            // Next-event estimation: one point on a light chosen by power (not through a delta lobe,
-            // which no light point can hit), both from one 2D point so that they stratify together.
-            let sample = match self.strategy {
-                PathStrategy::BsdfOnly => None,
-                _ if bsdf.is_delta() => None,
-                _ => lights.sample_li_reusing(SELECTION, surface.p, light_point.get_2d(0)),
-            };
-            if let Some(sample) = sample {
-                let (f_cos, local) = vertex.f_cos(sample.wi);
-                if f_cos != Vec3::ZERO {
-                    ctx.rays += 1;
-                    if !world.occluded(&surface.spawn_segment(sample.target)) {
-                        let weight = self.light_weight_over_pdf(sample.pdf, vertex.bsdf.pdf(wo, local));
-                        radiance += throughput * f_cos * sample.li * weight;
+            for (path, shadow) in paths.iter_mut().zip(&mut shadows) {
+                if let Some(test) = shadow.take() {
+                    *rays += 1;
+                    if !world.occluded(&test.segment) {
+                        path.radiance += test.contribution;
                     }
                 }
             }
+        }
+        paths.map(|path| path.radiance)
+    }
 
-            // BSDF sampling: where the path goes next.
-            let Some(scattered) = vertex.bsdf.sample(wo, scatter_point.get_2d(0)) else { break };
-            let wi = frame.to_world(scattered.wi);
-            if !vertex.sides_agree(wi, scattered.wi) {
-                break;
-            }
-            throughput *= scattered.f * (scattered.wi.z.abs() / scattered.pdf);
-            let specular = scattered.flags.contains(BsdfFlags::SPECULAR);
-            previous_pdf = if specular { f32::INFINITY } else { scattered.pdf };
-            ray = surface.spawn_ray(wi);
-
-            // Russian roulette, after `rr_depth` segments: survive with probability q, weigh by 1/q.
-            if depth >= self.rr_depth {
-                let q = throughput.max_element().min(0.95);
-                if q.is_nan() || survival.get_1d(0) >= q {
-                    break;
-                }
-                throughput /= q;
+    /// `path`'s ray meeting `hit`: adds the emission found there. False if the path ends here.
+    #[inline(always)]
+    fn arrive(&self, world: &World, path: &mut PathState, hit: &Hit) -> bool {
+        let lights = world.lights();
+        let ray = path.ray;
+        // Emission: the light this ray found, weighted against having sampled it as a light.
+        if let Some(light) = lights.light_of(hit.triangle) {
+            let emitted = lights.lights()[light as usize].radiance_towards(-ray.dir);
+            if emitted != Vec3::ZERO {
+                let weight = if path.previous_pdf.is_finite() {
+                    self.hit_weight(path.previous_pdf, lights.pdf_li(SELECTION, light, ray.dir, hit.t))
+                } else {
+                    1.0
+                };
+                path.radiance += path.throughput * emitted * weight;
             }
         }
+        path.depth += 1;
+        self.max_depth == 0 || path.depth < self.max_depth
+    }
+
+    /// The vertex at `surface`, where `path` arrived: draws the light sample (returned for its
+    /// shadow test) and the next direction. False if the path ends here.
+    ///
+    /// Out of line: inlined into `trace`'s loop, the Cornell box took 4% longer (its BSDF sampling
+    /// and sampler calls were laid out worse).
+    fn scatter(&self, world: &World, path: &mut PathState, surface: &SurfacePoint) -> (bool, Option<ShadowTest>) {
+        let lights = world.lights();
+        let ray = path.ray;
+        let bsdf = world.bsdf(surface);
+        // Opaque lobes scatter on the viewer's side, where `ns` is turned; a transmissive one
+        // needs its own orientation (`wo.z < 0` means inside), so its frame keeps the normal's.
+        let normal = if bsdf.transmits() && !surface.front_face { -surface.ns } else { surface.ns };
+        let frame = Frame::from_normal(normal);
+        let wo = frame.to_local(-ray.dir);
+        let vertex = Vertex { surface, bsdf, frame, wo };
+        // Each vertex takes three dimensions, whether it uses them or not, so that a bounce's
+        // numbers do not depend on the vertices before it; a dimension not used is not computed.
+        let stream = &mut path.stream;
+        let (light_point, scatter_point, survival) =
+            (stream.next_points(1), stream.next_points(1), stream.next_points(1));
+
+        // Next-event estimation: one point on a light chosen by power (not through a delta lobe,
+        // which no light point can hit), both from one 2D point so that they stratify together.
+        let sample = match self.strategy {
+            PathStrategy::BsdfOnly => None,
+            _ if bsdf.is_delta() => None,
+            _ => lights.sample_li_reusing(SELECTION, surface.p, light_point.get_2d(0)),
+        };
+        let mut shadow = None;
+        if let Some(sample) = sample {
+            let (f_cos, local) = vertex.f_cos(sample.wi);
+            if f_cos != Vec3::ZERO {
+                let weight = self.light_weight_over_pdf(sample.pdf, vertex.bsdf.pdf(wo, local));
+                shadow = Some(ShadowTest {
+                    segment: surface.spawn_segment(sample.target),
+                    contribution: path.throughput * f_cos * sample.li * weight,
+                });
+            }
+        }
+
+        // BSDF sampling: where the path goes next.
+        let Some(scattered) = vertex.bsdf.sample(wo, scatter_point.get_2d(0)) else { return (false, shadow) };
+        let wi = frame.to_world(scattered.wi);
+        if !vertex.sides_agree(wi, scattered.wi) {
+            return (false, shadow);
+        }
+        path.throughput *= scattered.f * (scattered.wi.z.abs() / scattered.pdf);
+        let specular = scattered.flags.contains(BsdfFlags::SPECULAR);
+        path.previous_pdf = if specular { f32::INFINITY } else { scattered.pdf };
+        path.ray = surface.spawn_ray(wi);
+
+        // Russian roulette, after `rr_depth` segments: survive with probability q, weigh by 1/q.
+        if path.depth >= self.rr_depth {
+            let q = path.throughput.max_element().min(0.95);
+            if q.is_nan() || survival.get_1d(0) >= q {
+                return (false, shadow);
+            }
+            path.throughput /= q;
+        }
+        (true, shadow)
+    }
+}
+
+impl Integrator for Path {
+    fn radiance(&self, world: &World, camera_ray: &Ray, ctx: &mut SampleContext) -> Vec3 {
+        let [radiance] = self.trace(world, &[*camera_ray], &[ctx.stream], 1, &mut ctx.rays);
         radiance
+    }
+
+    fn radiance_packet<'a>(
+        &self,
+        world: &World,
+        camera: &CameraPacket<'a>,
+        ctx: &mut SampleContext<'a>,
+    ) -> [Vec3; PACKET] {
+        self.trace(world, &camera.rays, &camera.streams, camera.live, &mut ctx.rays)
     }
 }

@@ -18,6 +18,7 @@ pub use quad::QuadLight;
 use crate::sampling::distrib::{AliasTable, ONE_MINUS_EPSILON};
 use crate::sampling::warp::sample_uniform_triangle;
 use crate::scene::Scene;
+use crate::util::memory::prefetch;
 
 /// How a light is chosen for one light sample.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -98,6 +99,14 @@ impl LightSet {
     pub fn light_of(&self, triangle: u32) -> Option<u32> {
         let index = *self.light_of_triangle.get(triangle as usize)?;
         (index != NOT_A_LIGHT).then_some(index)
+    }
+
+    /// Starts loading the entry [`LightSet::light_of`] reads for `triangle`.
+    #[inline]
+    pub fn prefetch_light_of(&self, triangle: u32) {
+        if let Some(entry) = self.light_of_triangle.get(triangle as usize) {
+            prefetch(entry);
+        }
     }
 
     /// Chooses a light with `u` in `[0, 1)`: its index and the probability of that choice.

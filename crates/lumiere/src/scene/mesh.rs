@@ -27,6 +27,21 @@ impl TriangleMesh {
         self.indices.len()
     }
 
+    /// The bytes of the arrays shading reads (positions, corners, materials, normals, texture
+    /// coordinates).
+    pub fn memory_bytes(&self) -> usize {
+        fn bytes<T>(values: &[T]) -> usize {
+            std::mem::size_of_val(values)
+        }
+        bytes(&self.positions)
+            + bytes(&self.indices)
+            + bytes(&self.material_ids)
+            + bytes(&self.normals)
+            + bytes(&self.normal_indices)
+            + bytes(&self.texcoords)
+            + bytes(&self.texcoord_indices)
+    }
+
     /// The three corner positions of triangle `id`.
     #[inline]
     pub fn vertices(&self, id: usize) -> [Vec3; 3] {

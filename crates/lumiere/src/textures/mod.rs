@@ -33,6 +33,8 @@ use glam::{Vec2, Vec3};
 use image::{DynamicImage, ImageFormat, ImageReader, Limits};
 use rayon::prelude::*;
 
+use crate::util::memory::prefetch;
+
 /// The most texels (width × height) an image may have: 2²⁶, e.g. 8192 × 8192, which takes 1 GiB
 /// as `f32` RGBA. Larger images are refused from their header, before any decoding.
 pub const MAX_TEXELS: u64 = 1 << 26;
@@ -73,6 +75,14 @@ impl Texels {
                 Vec3::new(table[r as usize], table[g as usize], table[b as usize])
             }
             Texels::Linear(rgb) => rgb[i],
+        }
+    }
+
+    #[inline]
+    fn prefetch(&self, i: usize) {
+        match self {
+            Texels::Srgb8 { codes, .. } => prefetch(&codes[i]),
+            Texels::Linear(rgb) => prefetch(&rgb[i]),
         }
     }
 
@@ -207,6 +217,16 @@ impl Texture {
         let [(i00, w00), (i10, w10), (i01, w01), (i11, w11)] = self.footprint(uv);
         let rgb = &self.rgb;
         rgb.get(i00) * w00 + rgb.get(i10) * w10 + rgb.get(i01) * w01 + rgb.get(i11) * w11
+    }
+
+    /// Starts loading the texels [`Texture::sample`] reads at `uv` (the first of each of its two
+    /// rows; the second of a row shares its cache line but at the line's end or the image's
+    /// edge), so that a lookup issued later does not wait for memory.
+    #[inline]
+    pub fn prefetch(&self, uv: Vec2) {
+        let [(i00, _), _, (i01, _), _] = self.footprint(uv);
+        self.rgb.prefetch(i00);
+        self.rgb.prefetch(i01);
     }
 
     /// The bilinearly filtered alpha at `uv`; 1 (opaque) for images without alpha.
@@ -418,6 +438,13 @@ impl TextureSet {
     /// The file texture `id` was decoded from.
     pub fn path(&self, id: TextureId) -> &Path {
         &self.paths[id.index()]
+    }
+
+    /// Starts loading the texels of texture `id` that a lookup at `uv` reads (see
+    /// [`Texture::prefetch`]).
+    #[inline]
+    pub fn prefetch(&self, id: TextureId, uv: Vec2) {
+        self.get(id).prefetch(uv);
     }
 
     /// The bilinearly filtered colour of texture `id` at `uv` (see [`Texture::sample`]).

@@ -19,3 +19,16 @@ pub fn ask_for_huge_pages<T>(start: *const T, len: usize) {
 
 #[cfg(not(target_os = "linux"))]
 pub fn ask_for_huge_pages<T>(_: *const T, _: usize) {}
+
+/// Asks the CPU to bring the cache line holding `value` into its caches, without waiting for it:
+/// a hint, so that a load issued later finds it there. No effect on what any load returns.
+#[inline(always)]
+pub fn prefetch<T>(value: &T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a prefetch reads nothing the program sees and cannot fault; SSE is baseline on x86-64.
+    unsafe {
+        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>((value as *const T).cast())
+    };
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = value;
+}

@@ -17,8 +17,8 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ("materials", &["math", "sampling"]),
     ("accel", &["geometry", "math"]),
     ("scene", &["error", "materials", "math", "util"]),
-    ("lights", &["geometry", "math", "sampling", "scene"]),
-    ("world", &["accel", "geometry", "lights", "materials", "math", "scene", "textures"]),
+    ("lights", &["geometry", "math", "sampling", "scene", "util"]),
+    ("world", &["accel", "geometry", "lights", "materials", "math", "scene", "textures", "util"]),
     (
         "integrators",
         &["accel", "error", "geometry", "lights", "materials", "math", "sampler", "sampling", "textures", "world"],
