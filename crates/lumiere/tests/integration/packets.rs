@@ -1,8 +1,10 @@
 //! Camera rays shaded as packets give each pixel the bits its single ray gives.
 
+use glam::Vec3;
 use lumiere::accel::OriginBatch;
 use lumiere::integrators::{CameraPacket, Integrator, PACKET, Path, SampleContext, Shadows};
 use lumiere::materials::MaterialKind;
+use lumiere::math::Ray;
 use lumiere::sampler::{SampleStream, Sampler, SamplerKind};
 use lumiere::scene::camera::Camera;
 use lumiere::scene::{Scene, builtin};
@@ -34,19 +36,13 @@ fn hard_shadow_packets_shade_mixed_materials_as_single_rays_do() {
     let (mut lit, mut compared) = (0, 0);
     for by in (0..height).step_by(4) {
         for bx in (0..width).step_by(4) {
-            let xs: [f32; PACKET] = std::array::from_fn(|lane| (bx + lane as u32 % 4) as f32 + 0.5);
-            let ys: [f32; PACKET] = std::array::from_fn(|lane| (by + lane as u32 / 4) as f32 + 0.5);
-            let rays = camera.rays(&xs, &ys);
+            let rays = block_rays(&camera, bx, by);
             let streams = std::array::from_fn(|lane| SampleStream::new(&sampler, lane as u32, 0));
             let packet = CameraPacket { rays, streams, live: u32::MAX >> (32 - PACKET) };
             let together = Shadows.radiance_packet(&world, &packet, &mut ctx);
             for lane in 0..PACKET {
                 let alone = Shadows.radiance(&world, &rays[lane], &mut ctx);
-                assert_eq!(
-                    together[lane].to_array().map(f32::to_bits),
-                    alone.to_array().map(f32::to_bits),
-                    "block ({bx}, {by}) lane {lane}"
-                );
+                assert_same_bits(together[lane], alone, &format!("block ({bx}, {by}) lane {lane}"));
                 lit += usize::from(alone.max_element() > 0.0);
                 compared += 1;
             }
@@ -62,7 +58,7 @@ fn hard_shadow_packets_shade_mixed_materials_as_single_rays_do() {
 #[test]
 fn paths_traced_in_lockstep_have_the_bits_of_paths_traced_alone() {
     let mut scene = Scene::builtin().unwrap();
-    for (i, material) in scene.materials.iter_mut().enumerate().filter(|(_, m)| m.ke == glam::Vec3::ZERO) {
+    for (i, material) in scene.materials.iter_mut().enumerate().filter(|(_, m)| m.ke == Vec3::ZERO) {
         match i % 4 {
             0 => (material.illum, material.ns) = (2, 20.0),
             1 => (material.illum, material.ni) = (7, 1.5),
@@ -92,9 +88,7 @@ fn paths_traced_in_lockstep_have_the_bits_of_paths_traced_alone() {
         for sample in 0..3 {
             for by in (0..height).step_by(4) {
                 for bx in (0..width).step_by(4) {
-                    let xs: [f32; PACKET] = std::array::from_fn(|lane| (bx + lane as u32 % 4) as f32 + 0.5);
-                    let ys: [f32; PACKET] = std::array::from_fn(|lane| (by + lane as u32 / 4) as f32 + 0.5);
-                    let rays = camera.rays(&xs, &ys);
+                    let rays = block_rays(&camera, bx, by);
                     let pixel = |lane: usize| (by + lane as u32 / 4) * width + bx + lane as u32 % 4;
                     let streams = std::array::from_fn(|lane| SampleStream::new(&sampler, pixel(lane), sample));
                     // Every other block leaves lanes out, a different set each time.
@@ -104,15 +98,15 @@ fn paths_traced_in_lockstep_have_the_bits_of_paths_traced_alone() {
                     let together = path.radiance_packet(&world, &packet, &mut ctx);
                     for lane in 0..PACKET {
                         if live & (1 << lane) == 0 {
-                            assert_eq!(together[lane], glam::Vec3::ZERO, "a lane left out is black");
+                            assert_eq!(together[lane], Vec3::ZERO, "a lane left out is black");
                             continue;
                         }
                         ctx.stream = streams[lane];
                         let alone = path.radiance(&world, &rays[lane], &mut ctx);
-                        assert_eq!(
-                            together[lane].to_array().map(f32::to_bits),
-                            alone.to_array().map(f32::to_bits),
-                            "{path:?}, sample {sample}, block ({bx}, {by}) lane {lane}"
+                        assert_same_bits(
+                            together[lane],
+                            alone,
+                            &format!("{path:?}, sample {sample}, block ({bx}, {by}) lane {lane}"),
                         );
                         lit += usize::from(alone.max_element() > 0.0);
                         compared += 1;
@@ -122,4 +116,15 @@ fn paths_traced_in_lockstep_have_the_bits_of_paths_traced_alone() {
         }
     }
     assert!(lit * 2 > compared, "{lit} of {compared} paths found light");
+}
+
+/// The camera rays through the centres of the 4x4 pixels from `(bx, by)`, lane `dy * 4 + dx`.
+fn block_rays(camera: &Camera, bx: u32, by: u32) -> [Ray; PACKET] {
+    let xs: [f32; PACKET] = std::array::from_fn(|lane| (bx + lane as u32 % 4) as f32 + 0.5);
+    let ys: [f32; PACKET] = std::array::from_fn(|lane| (by + lane as u32 / 4) as f32 + 0.5);
+    camera.rays(&xs, &ys)
+}
+
+fn assert_same_bits(together: Vec3, alone: Vec3, what: &str) {
+    assert_eq!(together.to_array().map(f32::to_bits), alone.to_array().map(f32::to_bits), "{what}");
 }
