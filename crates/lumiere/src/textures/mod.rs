@@ -219,9 +219,9 @@ impl Texture {
         rgb.get(i00) * w00 + rgb.get(i10) * w10 + rgb.get(i01) * w01 + rgb.get(i11) * w11
     }
 
-    /// Starts loading the texels [`Texture::sample`] reads at `uv` (the first of each of its two
-    /// rows; the second of a row shares its cache line but at the line's end or the image's
-    /// edge), so that a lookup issued later does not wait for memory.
+    /// Starts loading the texels [`Texture::sample`] reads at `uv`, so that a lookup issued later
+    /// does not wait for memory: the first texel of each of its two rows (the second texel of a
+    /// row lies in the same cache line, except at a line's end or where the row wraps).
     #[inline]
     pub fn prefetch(&self, uv: Vec2) {
         let [(i00, _), _, (i01, _), _] = self.footprint(uv);
