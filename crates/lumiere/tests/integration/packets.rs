@@ -26,13 +26,7 @@ fn hard_shadow_packets_shade_mixed_materials_as_single_rays_do() {
     let (width, height) = (64u32, 48u32);
     let camera = Camera::from_orbiter(&builtin::cornell_orbiter().unwrap(), width, height);
     let sampler = Sampler::new(SamplerKind::Independent, 1);
-    let stop = || false;
-    let mut ctx = SampleContext {
-        stream: SampleStream::new(&sampler, 0, 0),
-        batch: OriginBatch::default(),
-        rays: 0,
-        stop: &stop,
-    };
+    let mut ctx = context(&sampler);
     let (mut lit, mut compared) = (0, 0);
     for by in (0..height).step_by(4) {
         for bx in (0..width).step_by(4) {
@@ -75,13 +69,7 @@ fn paths_traced_in_lockstep_have_the_bits_of_paths_traced_alone() {
     let (width, height) = (32u32, 24u32);
     let camera = Camera::from_orbiter(&builtin::cornell_orbiter().unwrap(), width, height);
     let sampler = Sampler::new(SamplerKind::Sobol, 3);
-    let stop = || false;
-    let mut ctx = SampleContext {
-        stream: SampleStream::new(&sampler, 0, 0),
-        batch: OriginBatch::default(),
-        rays: 0,
-        stop: &stop,
-    };
+    let mut ctx = context(&sampler);
     let all = u32::MAX >> (32 - PACKET);
     let (mut lit, mut compared) = (0, 0);
     for path in [Path::default(), Path { max_depth: 0, ..Path::default() }] {
@@ -127,4 +115,9 @@ fn block_rays(camera: &Camera, bx: u32, by: u32) -> [Ray; PACKET] {
 
 fn assert_same_bits(together: Vec3, alone: Vec3, what: &str) {
     assert_eq!(together.to_array().map(f32::to_bits), alone.to_array().map(f32::to_bits), "{what}");
+}
+
+/// A sample context drawing from `sampler` that is never told to stop.
+fn context(sampler: &Sampler) -> SampleContext<'_> {
+    SampleContext { stream: SampleStream::new(sampler, 0, 0), batch: OriginBatch::default(), rays: 0, stop: &|| false }
 }
