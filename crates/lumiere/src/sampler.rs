@@ -136,6 +136,87 @@ impl<'a> SampleStream<'a> {
     }
 }
 
+/// The streams of `N` camera samples of one sampler that draw in lockstep, dimension after
+/// dimension (the paths of a block, traced together): the numbers of their [`SampleStream`]s,
+/// computed for all lanes at once in loops the compiler can vectorise. Drawn one lane at a time,
+/// a path vertex's hashes were 8% of a path-traced Cornell box.
+#[derive(Clone, Copy, Debug)]
+pub struct LaneStreams<'a, const N: usize> {
+    sampler: &'a Sampler,
+    pixel: [u32; N],
+    sample: [u32; N],
+    dimension: u32,
+}
+
+impl<'a, const N: usize> LaneStreams<'a, N> {
+    /// The lanes of `streams`, which must share their sampler and their next dimension.
+    ///
+    /// # Panics
+    /// If they do not.
+    pub fn new(streams: &[SampleStream<'a>; N]) -> Self {
+        let first = &streams[0];
+        assert!(
+            streams.iter().all(|s| std::ptr::eq(s.sampler, first.sampler) && s.dimension == first.dimension),
+            "streams drawn in lockstep share a sampler and a dimension"
+        );
+        LaneStreams {
+            sampler: first.sampler,
+            pixel: streams.map(|s| s.pixel),
+            sample: streams.map(|s| s.sample),
+            dimension: first.dimension,
+        }
+    }
+
+    /// [`SampleStream::next_2d`] of every lane.
+    #[inline(always)]
+    pub fn next_2d(&mut self) -> [Vec2; N] {
+        let (dimension, sampler) = (self.dimension, self.sampler);
+        self.dimension += 1;
+        // The first point of a one-point set has the sample's own index.
+        let (mut x, mut y) = ([0u32; N], [0u32; N]);
+        match sampler.kind {
+            SamplerKind::Independent => {
+                for lane in 0..N {
+                    let bits = sampler.independent_bits(self.pixel[lane], self.sample[lane], dimension);
+                    (x[lane], y[lane]) = ((bits >> 32) as u32, (bits << 24 >> 32) as u32);
+                }
+            }
+            SamplerKind::Sobol => {
+                for lane in 0..N {
+                    let seeds = SobolSeeds::new(sampler.key, self.pixel[lane], dimension);
+                    let i = shuffle(self.sample[lane], seeds.shuffle);
+                    x[lane] = scrambled_digits(i, seeds.x);
+                    y[lane] = scrambled_digits(sobol_second_digits(i), seeds.y);
+                }
+            }
+        }
+        std::array::from_fn(|lane| Vec2::new(unit_f32(x[lane]), unit_f32(y[lane])))
+    }
+
+    /// [`SampleStream::next_1d`] of every lane: the first coordinates of `next_2d`, without the
+    /// second's hashes.
+    #[inline(always)]
+    pub fn next_1d(&mut self) -> [f32; N] {
+        let (dimension, sampler) = (self.dimension, self.sampler);
+        self.dimension += 1;
+        let mut x = [0u32; N];
+        match sampler.kind {
+            SamplerKind::Independent => {
+                for (lane, x) in x.iter_mut().enumerate() {
+                    *x = (sampler.independent_bits(self.pixel[lane], self.sample[lane], dimension) >> 32) as u32;
+                }
+            }
+            SamplerKind::Sobol => {
+                for (lane, x) in x.iter_mut().enumerate() {
+                    let seeds = SobolSeeds::new(sampler.key, self.pixel[lane], dimension);
+                    *x = scrambled_digits(shuffle(self.sample[lane], seeds.shuffle), seeds.x);
+                }
+            }
+        }
+        x.map(unit_f32)
+    }
+}
+
 /// `n` points of one dimension of one camera sample (see [`SampleStream::next_points`]); nothing is
 /// computed until a point is asked for.
 #[derive(Clone, Copy, Debug)]
@@ -310,6 +391,38 @@ mod tests {
 
     /// The second dimension as Sobol defines it: the XOR of the direction numbers `vₖ = mₖ / 2ᵏ` of
     /// the index's set bits, with `mₖ = 2mₖ₋₁ ⊕ mₖ₋₁` (Pascal's triangle mod 2), in 0.32 fixed point.
+    #[test]
+    fn lanes_in_lockstep_draw_the_numbers_of_their_streams() {
+        for kind in [SamplerKind::Independent, SamplerKind::Sobol] {
+            let sampler = Sampler::new(kind, 7);
+            let mut streams: [SampleStream; 16] = std::array::from_fn(|lane| {
+                let lane = lane as u32;
+                SampleStream::new(&sampler, lane.wrapping_mul(2_654_435_761), lane * lane + u32::MAX / 3 * (lane % 2))
+            });
+            for stream in &mut streams {
+                stream.next_2d();
+            }
+            let mut lanes = LaneStreams::new(&streams);
+            for _ in 0..5 {
+                let (points, numbers) = (lanes.next_2d(), lanes.next_1d());
+                for (lane, stream) in streams.iter_mut().enumerate() {
+                    let bits = |v: Vec2| v.to_array().map(f32::to_bits);
+                    assert_eq!(bits(points[lane]), bits(stream.next_2d()), "{kind:?} lane {lane}");
+                    assert_eq!(numbers[lane].to_bits(), stream.next_1d().to_bits(), "{kind:?} lane {lane}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    #[should_panic(expected = "share a sampler and a dimension")]
+    fn lanes_in_lockstep_must_be_at_one_dimension() {
+        let sampler = Sampler::new(SamplerKind::Sobol, 7);
+        let mut streams = [SampleStream::new(&sampler, 0, 0); 2];
+        streams[1].next_1d();
+        LaneStreams::new(&streams);
+    }
+
     fn sobol_second_by_direction_numbers(index: u32) -> u32 {
         let mut m: u64 = 1;
         let mut x = 0;

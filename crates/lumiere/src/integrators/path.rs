@@ -11,7 +11,7 @@
 //! Depth counts as in Mitsuba 3: `max_depth` 1 shows the emitters the camera sees, 2 adds direct
 //! light, 8 allows up to seven bounces; 0 sets no limit (Russian roulette alone ends paths).
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 use super::{CameraPacket, Integrator, PACKET, SampleContext};
 use crate::accel::Hit;
@@ -20,7 +20,7 @@ use crate::geometry::surface::SurfacePoint;
 use crate::lights::LightSelection;
 use crate::materials::{Bsdf, BsdfFlags};
 use crate::math::{Frame, Ray};
-use crate::sampler::SampleStream;
+use crate::sampler::{LaneStreams, SampleStream};
 use crate::sampling::mis::power_heuristic;
 use crate::world::World;
 
@@ -116,7 +116,7 @@ impl<B: Bsdf> Vertex<'_, B> {
 }
 
 /// One path in flight: where it goes next and what it has gathered.
-struct PathState<'a> {
+struct PathState {
     ray: Ray,
     throughput: Vec3,
     radiance: Vec3,
@@ -125,7 +125,17 @@ struct PathState<'a> {
     previous_pdf: f32,
     /// Segments traced so far.
     depth: u32,
-    stream: SampleStream<'a>,
+}
+
+/// The random numbers of one path vertex. Each vertex takes three dimensions, whether it uses them
+/// or not, so that a bounce's numbers do not depend on the vertices before it.
+struct VertexNumbers {
+    /// Chooses the light and the point on it (next-event estimation).
+    light: Vec2,
+    /// Chooses the scattered direction.
+    scatter: Vec2,
+    /// Decides Russian roulette.
+    survival: f32,
 }
 
 /// A light sample a vertex found unblocked by its BSDF: what it adds if the segment is clear.
@@ -155,7 +165,8 @@ impl Path {
         mut live: u32,
         rays: &mut u64,
     ) -> [Vec3; N] {
-        let mut paths: [PathState<'a>; N] = std::array::from_fn(|lane| PathState {
+        let mut streams = LaneStreams::new(streams);
+        let mut paths: [PathState; N] = std::array::from_fn(|lane| PathState {
             // Unit directions from here on (BSDF samples are unit vectors): `wo` needs no
             // normalisation, and a hit's `t` is its distance, which the light pdf of an emitter
             // hit uses.
@@ -164,7 +175,6 @@ impl Path {
             radiance: Vec3::ZERO,
             previous_pdf: f32::INFINITY,
             depth: 0,
-            stream: streams[lane],
         });
         let mut shadows: [Option<ShadowTest>; N] = std::array::from_fn(|_| None);
         let mut surfaces = [SurfacePoint::default(); N];
@@ -186,8 +196,14 @@ impl Path {
                     _ => live &= !(1 << lane),
                 }
             }
+            // The vertices' numbers, for all lanes at once, dead ones included: the hashes vectorise.
+            let (light, scatter, survival) = world.simd(
+                #[inline(always)]
+                || (streams.next_2d(), streams.next_2d(), streams.next_1d()),
+            );
             for lane in lanes_of(live) {
-                let (continues, shadow) = self.scatter(world, &mut paths[lane], &surfaces[lane]);
+                let numbers = VertexNumbers { light: light[lane], scatter: scatter[lane], survival: survival[lane] };
+                let (continues, shadow) = self.scatter(world, &mut paths[lane], &surfaces[lane], &numbers);
                 if !continues {
                     live &= !(1 << lane);
                 }
@@ -231,7 +247,13 @@ impl Path {
     ///
     /// Out of line: inlined into `trace`'s loop, the Cornell box took 4% longer (its BSDF sampling
     /// and sampler calls were laid out worse).
-    fn scatter(&self, world: &World, path: &mut PathState, surface: &SurfacePoint) -> (bool, Option<ShadowTest>) {
+    fn scatter(
+        &self,
+        world: &World,
+        path: &mut PathState,
+        surface: &SurfacePoint,
+        numbers: &VertexNumbers,
+    ) -> (bool, Option<ShadowTest>) {
         let lights = world.lights();
         let ray = path.ray;
         let bsdf = world.bsdf(surface);
@@ -241,18 +263,12 @@ impl Path {
         let frame = Frame::from_normal(normal);
         let wo = frame.to_local(-ray.dir);
         let vertex = Vertex { surface, bsdf, frame, wo };
-        // Each vertex takes three dimensions, whether it uses them or not, so that a bounce's
-        // numbers do not depend on the vertices before it; a dimension not used is not computed.
-        let stream = &mut path.stream;
-        let (light_point, scatter_point, survival) =
-            (stream.next_points(1), stream.next_points(1), stream.next_points(1));
-
         // Next-event estimation: one point on a light chosen by power (not through a delta lobe,
         // which no light point can hit), both from one 2D point so that they stratify together.
         let sample = match self.strategy {
             PathStrategy::BsdfOnly => None,
             _ if bsdf.is_delta() => None,
-            _ => lights.sample_li_reusing(SELECTION, surface.p, light_point.get_2d(0)),
+            _ => lights.sample_li_reusing(SELECTION, surface.p, numbers.light),
         };
         let mut shadow = None;
         if let Some(sample) = sample {
@@ -267,7 +283,7 @@ impl Path {
         }
 
         // BSDF sampling: where the path goes next.
-        let Some(scattered) = vertex.bsdf.sample(wo, scatter_point.get_2d(0)) else { return (false, shadow) };
+        let Some(scattered) = vertex.bsdf.sample(wo, numbers.scatter) else { return (false, shadow) };
         let wi = frame.to_world(scattered.wi);
         if !vertex.sides_agree(wi, scattered.wi) {
             return (false, shadow);
@@ -280,7 +296,7 @@ impl Path {
         // Russian roulette, after `rr_depth` segments: survive with probability q, weigh by 1/q.
         if path.depth >= self.rr_depth {
             let q = path.throughput.max_element().min(0.95);
-            if q.is_nan() || survival.get_1d(0) >= q {
+            if q.is_nan() || numbers.survival >= q {
                 return (false, shadow);
             }
             path.throughput /= q;
