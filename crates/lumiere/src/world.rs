@@ -247,6 +247,12 @@ impl World {
         self.accel.simd(f)
     }
 
+    /// Runs `f` compiled for the ISA of the world's accel, at most 256 bits wide (see [`Accel::simd_256`]).
+    #[inline(always)]
+    pub fn simd_256<R>(&self, f: impl FnOnce() -> R) -> R {
+        self.accel.simd_256(f)
+    }
+
     /// Which of the `live` rays among `N` leaving the origin of `batch` with directions `dirs`
     /// (SoA) and one `tmax` are blocked, bit `i` for ray `i` (see [`Accel::occluded_lanes_in_batch`]).
     #[inline(always)]

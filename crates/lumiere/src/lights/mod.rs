@@ -118,7 +118,7 @@ impl LightSet {
     /// [`LightSet::choose`], and the part of `u` the choice left unused, rescaled to a uniform
     /// number in `[0, 1)` (see [`AliasTable::sample_remapped`]).
     #[inline]
-    fn choose_remapped(&self, selection: LightSelection, u: f32) -> Option<(u32, f32, f32)> {
+    pub fn choose_remapped(&self, selection: LightSelection, u: f32) -> Option<(u32, f32, f32)> {
         let n = self.lights.len();
         match selection {
             LightSelection::Uniform if n > 0 => {

@@ -1,0 +1,191 @@
+//! The diffuse vertices of a bounce, scattered together: `Path::scatter` for a Lambertian surface,
+//! for every lane of the lockstep paths at once, SoA, in one loop that the ISA vectorises whole.
+//! Each lane performs the scalar vertex's operations in their order: the same functions where
+//! they are pure (the frame, the triangle warp, the BSDF's `eval`, `pdf` and `sample`, the MIS
+//! weight) and `LightSet::sample_li_on`'s arithmetic written out, with every branch turned into a
+//! select, so that it gets the bits `Path::scatter` gives it (`packets.rs` and the golden images
+//! compare them on every ISA).
+//!
+//! Scattered one lane at a time, the vertices of the path-traced Cornell box took a quarter of its
+//! time, in chains of dependent square roots and divisions that one lane cannot overlap.
+
+use glam::{Vec2, Vec3};
+
+use crate::lights::AreaLight;
+use crate::materials::{Bsdf, Lambert};
+use crate::math::Frame;
+use crate::sampling::warp::sample_uniform_triangle;
+
+/// Vectors of `N` lanes, SoA: a row of x, one of y, one of z.
+pub(super) type Rows<const N: usize> = [[f32; N]; 3];
+
+/// Lane `lane` of `rows`.
+#[inline(always)]
+pub(super) fn row<const N: usize>(rows: &Rows<N>, lane: usize) -> Vec3 {
+    Vec3::new(rows[0][lane], rows[1][lane], rows[2][lane])
+}
+
+/// Sets lane `lane` of `rows` to `v`.
+#[inline(always)]
+pub(super) fn set<const N: usize>(rows: &mut Rows<N>, lane: usize, v: Vec3) {
+    [rows[0][lane], rows[1][lane], rows[2][lane]] = v.to_array();
+}
+
+/// What the lanes' vertices know before scattering, SoA: the surface, the arriving path, the
+/// light chosen for next-event estimation and the vertex's numbers.
+pub(super) struct DiffuseVertices<const N: usize> {
+    pub p: Rows<N>,
+    pub ng: Rows<N>,
+    pub ns: Rows<N>,
+    /// The arriving ray's (unit) direction.
+    pub dir: Rows<N>,
+    pub throughput: Rows<N>,
+    pub reflectance: Rows<N>,
+    /// The light chosen for the lane (lanes without one have 0 here and in `pmf`).
+    pub light: LightRows<N>,
+    /// The point on the light: the part of the light number the choice left, then its `y`.
+    pub light_point: [Vec2; N],
+    pub scatter_point: [Vec2; N],
+    pub survival: [f32; N],
+    /// Lanes that play Russian roulette at this vertex.
+    pub roulette: u32,
+}
+
+/// The chosen lights' records, SoA.
+pub(super) struct LightRows<const N: usize> {
+    pub targets: [Rows<N>; 3],
+    pub normal: Rows<N>,
+    pub area: [f32; N],
+    pub emission: Rows<N>,
+    /// The probability of the choice; lanes whose choice failed (no light) have none.
+    pub pmf: [f32; N],
+    pub chosen: u32,
+}
+
+impl<const N: usize> LightRows<N> {
+    /// Records lane `lane`'s choice of `light`, with probability `pmf`.
+    #[inline(always)]
+    pub fn choose(&mut self, lane: usize, light: &AreaLight, pmf: f32) {
+        for (rows, &target) in self.targets.iter_mut().zip(&light.shadow_targets) {
+            set(rows, lane, target);
+        }
+        set(&mut self.normal, lane, light.normal);
+        set(&mut self.emission, lane, light.emission);
+        self.area[lane] = light.area;
+        self.pmf[lane] = pmf;
+        self.chosen |= 1 << lane;
+    }
+}
+
+impl<const N: usize> Default for DiffuseVertices<N> {
+    fn default() -> Self {
+        let rows = [[0.0; N]; 3];
+        DiffuseVertices {
+            p: rows,
+            ng: rows,
+            ns: rows,
+            dir: rows,
+            throughput: rows,
+            reflectance: rows,
+            light: LightRows {
+                targets: [rows; 3],
+                normal: rows,
+                area: [0.0; N],
+                emission: rows,
+                pmf: [0.0; N],
+                chosen: 0,
+            },
+            light_point: [Vec2::ZERO; N],
+            scatter_point: [Vec2::ZERO; N],
+            survival: [0.0; N],
+            roulette: 0,
+        }
+    }
+}
+
+/// What the vertices' scattering gives, SoA: the light samples to test (their targets on the light
+/// and contributions if unblocked) and the paths' next directions, throughputs and densities.
+pub(super) struct DiffuseScattering<const N: usize> {
+    /// Lanes with a light sample to test.
+    pub shadowed: u32,
+    pub target: Rows<N>,
+    pub contribution: Rows<N>,
+    /// Lanes whose path goes on.
+    pub continues: u32,
+    pub wi: Rows<N>,
+    pub throughput: Rows<N>,
+    pub pdf: [f32; N],
+}
+
+impl<const N: usize> DiffuseVertices<N> {
+    /// Scatters every lane (run it in `World::simd_256`): lanes not filled in compute numbers nobody
+    /// reads. `light_weight_over_pdf` is the path tracer's MIS weight of a light sample over its
+    /// density (a function without branches on anything but its arguments, or the loop stays
+    /// scalar).
+    #[inline(always)]
+    #[expect(clippy::needless_range_loop, reason = "a lane indexes a dozen SoA rows")]
+    pub fn scatter(&self, light_weight_over_pdf: impl Fn(f32, f32) -> f32) -> DiffuseScattering<N> {
+        // Locals, not the fields of the result: the compiler does not vectorise the loop when its
+        // masks share memory with its rows.
+        let (mut shadowed, mut continues) = (0u32, 0u32);
+        let (mut targets, mut contributions) = ([[0.0; N]; 3], [[0.0; N]; 3]);
+        let (mut wis, mut throughputs, mut pdfs) = ([[0.0; N]; 3], [[0.0; N]; 3], [0.0; N]);
+        let light = &self.light;
+        for lane in 0..N {
+            let (ng, throughput) = (row(&self.ng, lane), row(&self.throughput, lane));
+            let bsdf = Lambert { reflectance: row(&self.reflectance, lane) };
+            // A Lambertian surface does not transmit: its frame is the shading normal's.
+            let frame = Frame::from_normal(row(&self.ns, lane));
+            let wo = frame.to_local(-row(&self.dir, lane));
+            // `f_cos`'s test: `wi` is a reflection in the geometry exactly when it is one in the frame.
+            let sides_agree = |wi: Vec3, local: Vec3| (ng.dot(wi) > 0.0) == (local.z * wo.z > 0.0);
+
+            // Next-event estimation: `LightSet::sample_li_on`, its pdf times the choice's.
+            let b = sample_uniform_triangle(self.light_point[lane]);
+            let [t0, t1, t2] = light.targets.each_ref().map(|rows| row(rows, lane));
+            let target = b.x * t0 + b.y * t1 + b.z * t2;
+            let v = target - row(&self.p, lane);
+            let dist2 = v.length_squared();
+            let dist = dist2.sqrt();
+            let inv_dist = 1.0 / dist;
+            let wi = v * inv_dist;
+            let cos_light_dist = -row(&light.normal, lane).dot(v);
+            let sampled = light.chosen >> lane & 1 != 0 && !(cos_light_dist <= 0.0 || dist2 <= 0.0);
+            let light_pdf = dist2 * dist / (cos_light_dist * light.area[lane]) * light.pmf[lane];
+            let local = frame.to_local(wi);
+            let f_cos = if sides_agree(wi, local) { bsdf.eval(wo, local) * local.z.abs() } else { Vec3::ZERO };
+            let weight = light_weight_over_pdf(light_pdf, bsdf.pdf(wo, local));
+            let contribution = throughput * f_cos * row(&light.emission, lane) * weight;
+            shadowed |= u32::from(sampled && f_cos != Vec3::ZERO) << lane;
+            set(&mut targets, lane, target);
+            set(&mut contributions, lane, contribution);
+
+            // BSDF sampling, then Russian roulette: survive with probability q, weigh by 1/q.
+            let (sampled, f, local, pdf) = match bsdf.sample(wo, self.scatter_point[lane]) {
+                Some(s) => (true, s.f, s.wi, s.pdf),
+                None => (false, Vec3::ZERO, Vec3::Z, 1.0),
+            };
+            let wi = frame.to_world(local);
+            let mut throughput = throughput * (f * (local.z.abs() / pdf));
+            let q = throughput.max_element().min(0.95);
+            let roulette = self.roulette >> lane & 1 != 0;
+            let survives = !roulette || !(q.is_nan() || self.survival[lane] >= q);
+            if roulette {
+                throughput /= q;
+            }
+            continues |= u32::from(sampled && sides_agree(wi, local) && survives) << lane;
+            set(&mut wis, lane, wi);
+            set(&mut throughputs, lane, throughput);
+            pdfs[lane] = pdf;
+        }
+        DiffuseScattering {
+            shadowed,
+            target: targets,
+            contribution: contributions,
+            continues,
+            wi: wis,
+            throughput: throughputs,
+            pdf: pdfs,
+        }
+    }
+}
