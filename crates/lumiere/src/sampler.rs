@@ -389,8 +389,6 @@ mod tests {
         }
     }
 
-    /// The second dimension as Sobol defines it: the XOR of the direction numbers `vₖ = mₖ / 2ᵏ` of
-    /// the index's set bits, with `mₖ = 2mₖ₋₁ ⊕ mₖ₋₁` (Pascal's triangle mod 2), in 0.32 fixed point.
     #[test]
     fn lanes_in_lockstep_draw_the_numbers_of_their_streams() {
         for kind in [SamplerKind::Independent, SamplerKind::Sobol] {
@@ -423,6 +421,8 @@ mod tests {
         LaneStreams::new(&streams);
     }
 
+    /// The second dimension as Sobol defines it: the XOR of the direction numbers `vₖ = mₖ / 2ᵏ` of
+    /// the index's set bits, with `mₖ = 2mₖ₋₁ ⊕ mₖ₋₁` (Pascal's triangle mod 2), in 0.32 fixed point.
     fn sobol_second_by_direction_numbers(index: u32) -> u32 {
         let mut m: u64 = 1;
         let mut x = 0;

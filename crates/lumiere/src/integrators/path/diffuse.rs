@@ -41,7 +41,7 @@ pub(super) struct DiffuseVertices<const N: usize> {
     pub dir: Rows<N>,
     pub throughput: Rows<N>,
     pub reflectance: Rows<N>,
-    /// The light chosen for the lane (lanes without one have 0 here and in `pmf`).
+    /// The light chosen for each lane.
     pub light: LightRows<N>,
     /// The point on the light: the part of the light number the choice left, then its `y`.
     pub light_point: [Vec2; N],
@@ -57,8 +57,9 @@ pub(super) struct LightRows<const N: usize> {
     pub normal: Rows<N>,
     pub area: [f32; N],
     pub emission: Rows<N>,
-    /// The probability of the choice; lanes whose choice failed (no light) have none.
+    /// The probability of the choice.
     pub pmf: [f32; N],
+    /// Lanes with a light chosen (none in a scene without lights): the others draw no light sample.
     pub chosen: u32,
 }
 

@@ -157,7 +157,9 @@ impl Path {
     /// bounce by bounce: every live path's next closest hit, then every path's surface point, then
     /// every path's scattering, then every shadow segment. Each path does exactly the operations,
     /// in the order, it would do alone (light found at a vertex is added before the next vertex's),
-    /// so its radiance has the same bits however many travel together.
+    /// so its radiance has the same bits however many travel together. From AVX2 up, the diffuse
+    /// vertices of a bounce are scattered together (`diffuse.rs`, with the bits of [`Path::scatter`]):
+    /// the box's vertices were a quarter of its time, one at a time.
     ///
     /// Together, the records a path's shading reads are asked for a phase before they are used
     /// (`World::prefetch_hit` after its hit, `World::prefetch_bsdf` after its surface point), and
@@ -337,12 +339,10 @@ impl Path {
         }
         (true, shadow)
     }
-}
 
-impl Path {
     /// Fills lane `lane` of `diffuse` with the vertex at `surface` of `path`, Lambertian of
     /// `reflectance`: what [`Path::scatter`] would read, and the light it would choose.
-    #[allow(clippy::too_many_arguments)]
+    #[expect(clippy::too_many_arguments, reason = "the vertex in its parts, and where it goes")]
     #[inline(always)]
     fn gather_diffuse<const N: usize>(
         &self,
@@ -365,7 +365,7 @@ impl Path {
         for (rows, v) in rows {
             diffuse::set(rows, lane, v);
         }
-        // `LightSet::sample_li_reusing`'s choice; no light sample without one, or without NEE.
+        // `LightSet::sample_li_reusing`'s choice (none in a scene without lights).
         let lights = world.lights();
         if let Some((index, pmf, remapped)) = lights.choose_remapped(SELECTION, numbers.light.x) {
             diffuse.light.choose(lane, &lights.lights()[index as usize], pmf);
