@@ -2,7 +2,7 @@
 //! for every lane of the lockstep paths at once, SoA, in one loop that the ISA vectorises whole.
 //! Each lane performs the scalar vertex's operations in their order: the same functions where
 //! they are pure (the frame, the triangle warp, the BSDF's `eval`, `pdf` and `sample`, the MIS
-//! weight) and `LightSet::sample_li_on`'s arithmetic written out, with every branch turned into a
+//! weight, the offset origins of the rays it spawns) and `LightSet::sample_li_on`'s arithmetic written out, with every branch turned into a
 //! select, so that it gets the bits `Path::scatter` gives it (`packets.rs` and the golden images
 //! compare them on every ISA).
 //!
@@ -11,9 +11,10 @@
 
 use glam::{Vec2, Vec3};
 
+use crate::geometry::surface::SurfacePoint;
 use crate::lights::AreaLight;
 use crate::materials::{Bsdf, Lambert};
-use crate::math::Frame;
+use crate::math::{Frame, Ray};
 use crate::sampling::warp::sample_uniform_triangle;
 
 /// Vectors of `N` lanes, SoA: a row of x, one of y, one of z.
@@ -104,18 +105,35 @@ impl<const N: usize> Default for DiffuseVertices<N> {
     }
 }
 
-/// What the vertices' scattering gives, SoA: the light samples to test (their targets on the light
-/// and contributions if unblocked) and the paths' next directions, throughputs and densities.
+/// What the vertices' scattering gives, SoA: the light samples to test (their shadow segments,
+/// which end at `t = 1`, and contributions if unblocked) and the paths' next rays, throughputs and
+/// densities.
 pub(super) struct DiffuseScattering<const N: usize> {
     /// Lanes with a light sample to test.
     pub shadowed: u32,
-    pub target: Rows<N>,
+    pub segment_origin: Rows<N>,
+    pub segment_dir: Rows<N>,
     pub contribution: Rows<N>,
     /// Lanes whose path goes on.
     pub continues: u32,
+    pub origin: Rows<N>,
     pub wi: Rows<N>,
     pub throughput: Rows<N>,
     pub pdf: [f32; N],
+}
+
+impl<const N: usize> DiffuseScattering<N> {
+    /// Lane `lane`'s shadow segment.
+    #[inline(always)]
+    pub fn segment(&self, lane: usize) -> Ray {
+        Ray { origin: row(&self.segment_origin, lane), dir: row(&self.segment_dir, lane), tmax: 1.0 }
+    }
+
+    /// Lane `lane`'s next ray.
+    #[inline(always)]
+    pub fn ray(&self, lane: usize) -> Ray {
+        Ray::new(row(&self.origin, lane), row(&self.wi, lane))
+    }
 }
 
 impl<const N: usize> DiffuseVertices<N> {
@@ -129,11 +147,14 @@ impl<const N: usize> DiffuseVertices<N> {
         // Locals, not the fields of the result: the compiler does not vectorise the loop when its
         // masks share memory with its rows.
         let (mut shadowed, mut continues) = (0u32, 0u32);
-        let (mut targets, mut contributions) = ([[0.0; N]; 3], [[0.0; N]; 3]);
-        let (mut wis, mut throughputs, mut pdfs) = ([[0.0; N]; 3], [[0.0; N]; 3], [0.0; N]);
+        let rows = [[0.0; N]; 3];
+        let (mut segment_origins, mut segment_dirs, mut contributions) = (rows, rows, rows);
+        let (mut origins, mut wis, mut throughputs, mut pdfs) = (rows, rows, rows, [0.0; N]);
         let light = &self.light;
         for lane in 0..N {
             let (ng, throughput) = (row(&self.ng, lane), row(&self.throughput, lane));
+            // The surface point as far as spawning rays from it goes.
+            let surface = SurfacePoint { p: row(&self.p, lane), ng, ..Default::default() };
             let bsdf = Lambert { reflectance: row(&self.reflectance, lane) };
             // A Lambertian surface does not transmit: its frame is the shading normal's.
             let frame = Frame::from_normal(row(&self.ns, lane));
@@ -145,7 +166,7 @@ impl<const N: usize> DiffuseVertices<N> {
             let b = sample_uniform_triangle(self.light_point[lane]);
             let [t0, t1, t2] = light.targets.each_ref().map(|rows| row(rows, lane));
             let target = b.x * t0 + b.y * t1 + b.z * t2;
-            let v = target - row(&self.p, lane);
+            let v = target - surface.p;
             let dist2 = v.length_squared();
             let dist = dist2.sqrt();
             let inv_dist = 1.0 / dist;
@@ -158,7 +179,9 @@ impl<const N: usize> DiffuseVertices<N> {
             let weight = light_weight_over_pdf(light_pdf, bsdf.pdf(wo, local));
             let contribution = throughput * f_cos * row(&light.emission, lane) * weight;
             shadowed |= u32::from(sampled && f_cos != Vec3::ZERO) << lane;
-            set(&mut targets, lane, target);
+            let segment = surface.spawn_segment(target);
+            set(&mut segment_origins, lane, segment.origin);
+            set(&mut segment_dirs, lane, segment.dir);
             set(&mut contributions, lane, contribution);
 
             // BSDF sampling, then Russian roulette: survive with probability q, weigh by 1/q.
@@ -175,15 +198,18 @@ impl<const N: usize> DiffuseVertices<N> {
                 throughput /= q;
             }
             continues |= u32::from(sampled && sides_agree(wi, local) && survives) << lane;
+            set(&mut origins, lane, surface.spawn_ray(wi).origin);
             set(&mut wis, lane, wi);
             set(&mut throughputs, lane, throughput);
             pdfs[lane] = pdf;
         }
         DiffuseScattering {
             shadowed,
-            target: targets,
+            segment_origin: segment_origins,
+            segment_dir: segment_dirs,
             contribution: contributions,
             continues,
+            origin: origins,
             wi: wis,
             throughput: throughputs,
             pdf: pdfs,

@@ -243,7 +243,7 @@ impl Path {
                 shadows[lane] = shadow;
             }
             if diffuse_lanes != 0 {
-                live &= !scatter_diffuse(world, &diffuse, diffuse_lanes, &mut paths, &surfaces, &mut shadows);
+                live &= !scatter_diffuse(world, &diffuse, diffuse_lanes, &mut paths, &mut shadows);
             }
             for (path, shadow) in paths.iter_mut().zip(&mut shadows) {
                 if let Some(test) = shadow.take() {
@@ -384,7 +384,6 @@ fn scatter_diffuse<const N: usize>(
     diffuse: &DiffuseVertices<N>,
     lanes: u32,
     paths: &mut [PathState; N],
-    surfaces: &[SurfacePoint; N],
     shadows: &mut [Option<ShadowTest>; N],
 ) -> u32 {
     let out = world.simd_256(
@@ -392,14 +391,13 @@ fn scatter_diffuse<const N: usize>(
         || diffuse.scatter(mis_light_weight_over_pdf),
     );
     for lane in lanes_of(lanes & out.shadowed) {
-        let (target, contribution) = (row(&out.target, lane), row(&out.contribution, lane));
-        shadows[lane] = Some(ShadowTest { segment: surfaces[lane].spawn_segment(target), contribution });
+        shadows[lane] = Some(ShadowTest { segment: out.segment(lane), contribution: row(&out.contribution, lane) });
     }
     for lane in lanes_of(lanes & out.continues) {
         let path = &mut paths[lane];
         path.throughput = row(&out.throughput, lane);
         path.previous_pdf = out.pdf[lane];
-        path.ray = surfaces[lane].spawn_ray(row(&out.wi, lane));
+        path.ray = out.ray(lane);
     }
     lanes & !out.continues
 }
