@@ -185,7 +185,7 @@ impl<const N: usize> DiffuseVertices<N> {
             set(&mut contributions, lane, contribution);
 
             // BSDF sampling, then Russian roulette: survive with probability q, weigh by 1/q.
-            let (sampled, f, local, pdf) = match bsdf.sample(wo, self.scatter_point[lane]) {
+            let (scattered, f, local, pdf) = match bsdf.sample(wo, self.scatter_point[lane]) {
                 Some(s) => (true, s.f, s.wi, s.pdf),
                 None => (false, Vec3::ZERO, Vec3::Z, 1.0),
             };
@@ -197,7 +197,7 @@ impl<const N: usize> DiffuseVertices<N> {
             if roulette {
                 throughput /= q;
             }
-            continues |= u32::from(sampled && sides_agree(wi, local) && survives) << lane;
+            continues |= u32::from(scattered && sides_agree(wi, local) && survives) << lane;
             set(&mut origins, lane, surface.spawn_ray(wi).origin);
             set(&mut wis, lane, wi);
             set(&mut throughputs, lane, throughput);
