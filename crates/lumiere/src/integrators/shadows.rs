@@ -6,6 +6,7 @@ use crate::accel::simd::lanes_of;
 use crate::geometry::surface::SurfacePoint;
 use crate::lights::AreaLight;
 use crate::materials::{Bsdf, MaterialBsdf};
+use crate::math::rows::set_row;
 use crate::math::{Frame, Ray, offset_ray_origin};
 use crate::world::World;
 
@@ -110,7 +111,7 @@ impl DiffuseLanes {
             (&mut self.f, f),
             (&mut self.origin, origin),
         ] {
-            [rows[0][lane], rows[1][lane], rows[2][lane]] = value.to_array();
+            set_row(rows, lane, value);
         }
     }
 

@@ -4,6 +4,7 @@ mod aabb;
 mod frame;
 mod offset;
 mod ray;
+pub mod rows;
 
 pub use aabb::Aabb;
 pub use frame::Frame;

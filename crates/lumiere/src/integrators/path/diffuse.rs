@@ -14,23 +14,9 @@ use glam::{Vec2, Vec3};
 use crate::geometry::surface::SurfacePoint;
 use crate::lights::AreaLight;
 use crate::materials::{Bsdf, Lambert};
+use crate::math::rows::{Rows, row, set_row};
 use crate::math::{Frame, Ray};
 use crate::sampling::warp::sample_uniform_triangle;
-
-/// Vectors of `N` lanes, SoA: a row of x, one of y, one of z.
-pub(super) type Rows<const N: usize> = [[f32; N]; 3];
-
-/// Lane `lane` of `rows`.
-#[inline(always)]
-pub(super) fn row<const N: usize>(rows: &Rows<N>, lane: usize) -> Vec3 {
-    Vec3::new(rows[0][lane], rows[1][lane], rows[2][lane])
-}
-
-/// Sets lane `lane` of `rows` to `v`.
-#[inline(always)]
-pub(super) fn set<const N: usize>(rows: &mut Rows<N>, lane: usize, v: Vec3) {
-    [rows[0][lane], rows[1][lane], rows[2][lane]] = v.to_array();
-}
 
 /// What the lanes' vertices know before scattering, SoA: the surface, the arriving path, the
 /// light chosen for next-event estimation and the vertex's numbers.
@@ -69,10 +55,10 @@ impl<const N: usize> LightRows<N> {
     #[inline(always)]
     pub fn choose(&mut self, lane: usize, light: &AreaLight, pmf: f32) {
         for (rows, &target) in self.targets.iter_mut().zip(&light.shadow_targets) {
-            set(rows, lane, target);
+            set_row(rows, lane, target);
         }
-        set(&mut self.normal, lane, light.normal);
-        set(&mut self.emission, lane, light.emission);
+        set_row(&mut self.normal, lane, light.normal);
+        set_row(&mut self.emission, lane, light.emission);
         self.area[lane] = light.area;
         self.pmf[lane] = pmf;
         self.chosen |= 1 << lane;
@@ -180,9 +166,9 @@ impl<const N: usize> DiffuseVertices<N> {
             let contribution = throughput * f_cos * row(&light.emission, lane) * weight;
             shadowed |= u32::from(sampled && f_cos != Vec3::ZERO) << lane;
             let segment = surface.spawn_segment(target);
-            set(&mut segment_origins, lane, segment.origin);
-            set(&mut segment_dirs, lane, segment.dir);
-            set(&mut contributions, lane, contribution);
+            set_row(&mut segment_origins, lane, segment.origin);
+            set_row(&mut segment_dirs, lane, segment.dir);
+            set_row(&mut contributions, lane, contribution);
 
             // BSDF sampling, then Russian roulette: survive with probability q, weigh by 1/q.
             let (scattered, f, local, pdf) = match bsdf.sample(wo, self.scatter_point[lane]) {
@@ -198,9 +184,9 @@ impl<const N: usize> DiffuseVertices<N> {
                 throughput /= q;
             }
             continues |= u32::from(scattered && sides_agree(wi, local) && survives) << lane;
-            set(&mut origins, lane, surface.spawn_ray(wi).origin);
-            set(&mut wis, lane, wi);
-            set(&mut throughputs, lane, throughput);
+            set_row(&mut origins, lane, surface.spawn_ray(wi).origin);
+            set_row(&mut wis, lane, wi);
+            set_row(&mut throughputs, lane, throughput);
             pdfs[lane] = pdf;
         }
         DiffuseScattering {

@@ -15,13 +15,14 @@ mod diffuse;
 
 use glam::{Vec2, Vec3};
 
-use self::diffuse::{DiffuseVertices, row};
+use self::diffuse::DiffuseVertices;
 use super::{CameraPacket, Integrator, PACKET, SampleContext};
 use crate::accel::simd::lanes_of;
 use crate::accel::{Hit, Isa};
 use crate::geometry::surface::SurfacePoint;
 use crate::lights::LightSelection;
 use crate::materials::{Bsdf, BsdfFlags, MaterialBsdf};
+use crate::math::rows::{row, set_row};
 use crate::math::{Frame, Ray};
 use crate::sampler::{LaneStreams, SampleStream};
 use crate::sampling::mis::power_heuristic;
@@ -363,7 +364,7 @@ impl Path {
             (&mut diffuse.reflectance, reflectance),
         ];
         for (rows, v) in rows {
-            diffuse::set(rows, lane, v);
+            set_row(rows, lane, v);
         }
         // `LightSet::sample_li_reusing`'s choice (none in a scene without lights).
         let lights = world.lights();
