@@ -137,6 +137,19 @@ impl World {
         }
     }
 
+    /// Starts loading the corner positions of `hit`'s triangle, which [`World::surface`] reads
+    /// once its indices are in: call it a while after [`World::prefetch_hit`].
+    #[inline]
+    pub fn prefetch_corners(&self, hit: &Hit) {
+        if !self.prefetches {
+            return;
+        }
+        let mesh = &self.scene.mesh;
+        for corner in mesh.indices[hit.triangle as usize] {
+            prefetch(&mesh.positions[corner as usize]);
+        }
+    }
+
     /// Starts loading what [`World::bsdf`] will read at `surface` (its texels), so that other work
     /// can run while they come from memory.
     #[inline]

