@@ -6,9 +6,11 @@ use glam::{Vec2, Vec3};
 use crate::accel::simd::lanes_of;
 use crate::accel::{Accel, BuildPreset, Hit, Isa, OriginBatch, Region};
 use crate::geometry::surface::SurfacePoint;
+use crate::geometry::surface_lanes::HitCorners;
 use crate::lights::LightSet;
 use crate::materials::{Material, MaterialBsdf, MaterialKind};
 use crate::math::Ray;
+use crate::math::rows::{Rows, set_row};
 use crate::scene::Scene;
 use crate::scene::mesh::NO_INDEX;
 use crate::textures::{TextureId, TextureSet};
@@ -134,19 +136,6 @@ impl World {
         }
         if let Some(corners) = mesh.texcoord_indices.get(id) {
             prefetch(corners);
-        }
-    }
-
-    /// Starts loading the corner positions of `hit`'s triangle, which [`World::surface`] reads
-    /// once its indices are in: call it a while after [`World::prefetch_hit`].
-    #[inline]
-    pub fn prefetch_corners(&self, hit: &Hit) {
-        if !self.prefetches {
-            return;
-        }
-        let mesh = &self.scene.mesh;
-        for corner in mesh.indices[hit.triangle as usize] {
-            prefetch(&mesh.positions[corner as usize]);
         }
     }
 
@@ -305,6 +294,50 @@ impl World {
         let ns = self.interpolated_normal(id, w, hit.u, hit.v).map_or(ng, |n| if n.dot(ng) < 0.0 { -n } else { n });
         let uv = self.interpolated_texcoord(id, w, hit.u, hit.v);
         SurfacePoint { p, ng, ns, uv, triangle: hit.triangle, material: mesh.material_ids[id], front_face }
+    }
+
+    /// [`World::surface`] of every lane of `rays` with a hit (default points elsewhere), with its
+    /// bits, computed together: the corners gathered lane by lane, the rest in a lane loop in the
+    /// ISA's width (`geometry/surface_lanes.rs`).
+    #[inline]
+    pub fn surfaces<const N: usize>(&self, rays: &[Ray; N], hits: &[Option<Hit>; N]) -> [SurfacePoint; N] {
+        let mesh = &self.scene.mesh;
+        let mut corners = HitCorners::<N>::default();
+        for (lane, hit) in hits.iter().enumerate() {
+            let Some(hit) = hit else { continue };
+            let id = hit.triangle as usize;
+            let gather = |corners: &mut [Rows<N>; 3], values: &[Vec3], indices: [u32; 3]| {
+                for (rows, index) in corners.iter_mut().zip(indices) {
+                    set_row(rows, lane, values[index as usize]);
+                }
+            };
+            gather(&mut corners.positions, &mesh.positions, mesh.indices[id]);
+            if let Some(&indices) = mesh.normal_indices.get(id)
+                && !indices.contains(&NO_INDEX)
+            {
+                gather(&mut corners.normals, &mesh.normals, indices);
+                corners.normals_given[lane] = true;
+            }
+            if let Some(&indices) = mesh.texcoord_indices.get(id)
+                && !indices.contains(&NO_INDEX)
+            {
+                for (rows, index) in corners.texcoords.iter_mut().zip(indices) {
+                    let value = mesh.texcoords[index as usize];
+                    (rows[0][lane], rows[1][lane]) = (value.x, value.y);
+                }
+                corners.texcoords_given[lane] = true;
+            }
+            (corners.u[lane], corners.v[lane]) = (hit.u, hit.v);
+            set_row(&mut corners.dir, lane, rays[lane].dir);
+        }
+        let rows = self.simd_256(
+            #[inline(always)]
+            || corners.surface_rows(),
+        );
+        std::array::from_fn(|lane| match hits[lane] {
+            Some(hit) => rows.point(lane, hit.triangle, mesh.material_ids[hit.triangle as usize]),
+            None => SurfacePoint::default(),
+        })
     }
 
     fn interpolated_normal(&self, id: usize, w: f32, u: f32, v: f32) -> Option<Vec3> {

@@ -3,8 +3,8 @@ use std::ops::Range;
 use glam::{Vec2, Vec3};
 
 use super::{NARROW_GROUP, SampleContext, ShadesClosestHit, WIDE_GROUP};
-use crate::accel::Hit;
 use crate::accel::{OriginBatch, Region};
+use crate::geometry::surface::SurfacePoint;
 use crate::math::{Frame, Ray};
 use crate::sampler::PointSet;
 use crate::sampling::warp::sample_cosine_hemisphere;
@@ -35,9 +35,8 @@ pub struct AmbientOcclusion {
 const MIN_QUARTER_BATCH: u32 = 128;
 
 impl ShadesClosestHit for AmbientOcclusion {
-    fn shade(&self, world: &World, ray: &Ray, hit: Option<Hit>, ctx: &mut SampleContext) -> Vec3 {
-        let Some(hit) = hit else { return Vec3::ZERO };
-        let surface = world.surface(ray, &hit);
+    fn shade(&self, world: &World, _: &Ray, surface: Option<&SurfacePoint>, ctx: &mut SampleContext) -> Vec3 {
+        let Some(surface) = surface else { return Vec3::ZERO };
         let frame = Frame::from_normal(surface.ng);
         let directions = Directions { points: ctx.stream.next_points(self.samples), quarters: self.quarters() };
         // All probes leave from one origin into the half-space above the surface: trace them as a

@@ -2,7 +2,7 @@ use glam::{Vec2, Vec3};
 
 use super::{NARROW_GROUP, SampleContext, ShadesClosestHit, WIDE_GROUP, shading_frame};
 use crate::accel::simd::lanes_of;
-use crate::accel::{Hit, OriginBatch, Region};
+use crate::accel::{OriginBatch, Region};
 use crate::geometry::surface::SurfacePoint;
 use crate::lights::{AreaLight, LightSample, LightSelection, LightSet};
 use crate::materials::Bsdf;
@@ -271,16 +271,15 @@ fn faces_each_other(surface: &SurfacePoint, light: &AreaLight) -> bool {
 }
 
 impl ShadesClosestHit for Direct {
-    fn shade(&self, world: &World, ray: &Ray, hit: Option<Hit>, ctx: &mut SampleContext) -> Vec3 {
-        let Some(hit) = hit else { return Vec3::ZERO };
+    fn shade(&self, world: &World, ray: &Ray, surface: Option<&SurfacePoint>, ctx: &mut SampleContext) -> Vec3 {
+        let Some(surface) = surface else { return Vec3::ZERO };
         // A light seen from the side it faces shows its emission; from behind it is a surface.
-        let emitted = world.emitted(hit.triangle, ray);
+        let emitted = world.emitted(surface.triangle, ray);
         if emitted != Vec3::ZERO {
             return emitted;
         }
-        let surface = world.surface(ray, &hit);
         let (frame, wo) = shading_frame(surface.ns, ray);
-        let receiver = Receiver { surface: &surface, bsdf: world.bsdf(&surface), frame, wo };
+        let receiver = Receiver { surface, bsdf: world.bsdf(surface), frame, wo };
         // Every shadow ray leaves above the geometric surface (the others are skipped), so they
         // share one origin.
         let origin = surface.offset_origin(surface.ng);
@@ -298,7 +297,7 @@ impl ShadesClosestHit for Direct {
                 for (index, light) in lights.lights().iter().enumerate() {
                     // Taken for every light, lit or not, so that each light keeps its dimension.
                     let points = ctx.stream.next_points(n);
-                    if !faces_each_other(&surface, light) {
+                    if !faces_each_other(surface, light) {
                         continue;
                     }
                     let quad = lights.quad_of(index as u32);

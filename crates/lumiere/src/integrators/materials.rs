@@ -1,7 +1,7 @@
 use glam::Vec3;
 
 use super::{SampleContext, ShadesClosestHit};
-use crate::accel::Hit;
+use crate::geometry::surface::SurfacePoint;
 use crate::materials::Bsdf;
 use crate::math::Ray;
 use crate::world::World;
@@ -11,7 +11,7 @@ use crate::world::World;
 pub struct Materials;
 
 impl ShadesClosestHit for Materials {
-    fn shade(&self, world: &World, ray: &Ray, hit: Option<Hit>, _: &mut SampleContext) -> Vec3 {
-        hit.map_or(Vec3::ZERO, |hit| world.bsdf(&world.surface(ray, &hit)).albedo())
+    fn shade(&self, world: &World, _: &Ray, surface: Option<&SurfacePoint>, _: &mut SampleContext) -> Vec3 {
+        surface.map_or(Vec3::ZERO, |surface| world.bsdf(surface).albedo())
     }
 }

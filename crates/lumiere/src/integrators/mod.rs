@@ -10,9 +10,10 @@ mod shadows;
 
 use glam::Vec3;
 
+use crate::accel::OriginBatch;
 use crate::accel::simd::lanes_of;
-use crate::accel::{Hit, OriginBatch};
 use crate::error::{Error, Result};
+use crate::geometry::surface::SurfacePoint;
 use crate::math::{Frame, Ray};
 use crate::sampler::SampleStream;
 use crate::world::World;
@@ -164,10 +165,11 @@ pub trait Integrator: Sync {
 
 /// An integrator whose radiance is a function of the camera ray's closest hit: it gets
 /// [`Integrator`] from this, with the hits of a packet's camera rays found together
-/// ([`World::intersect_packet`]).
+/// ([`World::intersect_packet`]) and their surface points computed together ([`World::surfaces`]).
 pub trait ShadesClosestHit: Sync {
-    /// The radiance along the camera ray `ray`, whose closest hit is `hit` (the ray is counted).
-    fn shade(&self, world: &World, ray: &Ray, hit: Option<Hit>, ctx: &mut SampleContext) -> Vec3;
+    /// The radiance along the camera ray `ray`, whose closest hit has the surface point `surface`
+    /// (`None` for a miss; the ray is counted).
+    fn shade(&self, world: &World, ray: &Ray, surface: Option<&SurfacePoint>, ctx: &mut SampleContext) -> Vec3;
 }
 
 impl<T: ShadesClosestHit> Integrator for T {
@@ -175,7 +177,8 @@ impl<T: ShadesClosestHit> Integrator for T {
 
     fn radiance(&self, world: &World, ray: &Ray, ctx: &mut SampleContext) -> Vec3 {
         ctx.rays += 1;
-        self.shade(world, ray, world.intersect(ray), ctx)
+        let surface = world.intersect(ray).map(|hit| world.surface(ray, &hit));
+        self.shade(world, ray, surface.as_ref(), ctx)
     }
 
     fn radiance_packet<'a>(
@@ -185,20 +188,12 @@ impl<T: ShadesClosestHit> Integrator for T {
         ctx: &mut SampleContext<'a>,
     ) -> [Vec3; PACKET] {
         let hits = world.intersect_packet(&camera.rays, camera.live);
-        // On a large mesh each hit's records are cache misses, indices first, then corners: ask
-        // for every lane's indices now and for a lane's corners while the lane before is shaded
-        // (the 1.1M-triangle bunny's AO: 1,127 -> 1,097 ms; small scenes skip it).
-        for hit in hits.iter().flatten() {
-            world.prefetch_hit(hit);
-        }
+        let surfaces = world.surfaces(&camera.rays, &hits);
         let mut radiance = [Vec3::ZERO; PACKET];
         for lane in camera.lanes() {
-            if let Some(next) = hits.get(lane + 1).copied().flatten() {
-                world.prefetch_corners(&next);
-            }
             ctx.stream = camera.streams[lane];
             ctx.rays += 1;
-            radiance[lane] = self.shade(world, &camera.rays[lane], hits[lane], ctx);
+            radiance[lane] = self.shade(world, &camera.rays[lane], hits[lane].map(|_| &surfaces[lane]), ctx);
         }
         radiance
     }

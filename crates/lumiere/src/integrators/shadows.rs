@@ -20,7 +20,7 @@ impl Integrator for Shadows {
 
     fn radiance(&self, world: &World, ray: &Ray, ctx: &mut SampleContext) -> Vec3 {
         ctx.rays += 1;
-        let receiver = match Receiver::new(world, ray, world.intersect(ray)) {
+        let receiver = match Receiver::new(world, ray, world.intersect(ray), |hit| world.surface(ray, hit)) {
             Ok(receiver) => receiver,
             Err(radiance) => return radiance,
         };
@@ -49,12 +49,13 @@ impl Integrator for Shadows {
         ctx: &mut SampleContext<'a>,
     ) -> [Vec3; PACKET] {
         let hits = world.intersect_packet(&camera.rays, camera.live);
+        let surfaces = world.surfaces(&camera.rays, &hits);
         ctx.rays += u64::from(camera.live.count_ones());
         let mut radiance = [Vec3::ZERO; PACKET];
         let mut diffuse = DiffuseLanes::default();
         let mut others: [Option<Receiver>; PACKET] = [None; PACKET];
         for lane in camera.lanes() {
-            match Receiver::new(world, &camera.rays[lane], hits[lane]) {
+            match Receiver::new(world, &camera.rays[lane], hits[lane], |_| surfaces[lane]) {
                 Ok(Receiver { surface, lambertian: Some(f), .. }) => diffuse.set(lane, &surface, f),
                 Ok(receiver) => others[lane] = Some(receiver),
                 Err(value) => radiance[lane] = value,
@@ -199,16 +200,22 @@ struct Receiver {
 }
 
 impl Receiver {
-    /// The receiver at the camera ray's closest hit, or the pixel's final value: black for a
-    /// miss, the emission of a light seen from the side it faces (from behind it is a surface).
+    /// The receiver at the camera ray's closest hit, whose surface point `surface` gives, or the
+    /// pixel's final value: black for a miss, the emission of a light seen from the side it faces
+    /// (from behind it is a surface).
     #[inline]
-    fn new(world: &World, ray: &Ray, hit: Option<Hit>) -> Result<Receiver, Vec3> {
+    fn new(
+        world: &World,
+        ray: &Ray,
+        hit: Option<Hit>,
+        surface: impl FnOnce(&Hit) -> SurfacePoint,
+    ) -> Result<Receiver, Vec3> {
         let Some(hit) = hit else { return Err(Vec3::ZERO) };
         let emitted = world.emitted(hit.triangle, ray);
         if emitted != Vec3::ZERO {
             return Err(emitted);
         }
-        let surface = world.surface(ray, &hit);
+        let surface = surface(&hit);
         let bsdf = world.bsdf(&surface);
         let (frame, wo) = shading_frame(surface.ns, ray);
         Ok(Receiver { surface, bsdf, lambertian: bsdf.lambertian_eval(wo), frame, wo })

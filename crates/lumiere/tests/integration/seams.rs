@@ -274,6 +274,58 @@ fn spawned_rays_leave_on_their_side_and_miss_their_own_triangle() {
     }
 }
 
+/// The surface points of a packet's hits, computed together in the ISA's lanes, have the bits of
+/// `World::surface` one hit at a time: on faces with and without vertex normals and texture
+/// coordinates, a degenerate face, hits from both sides, barycentrics outside the triangle, and
+/// lanes without a hit (default points), for every ISA this CPU has.
+#[test]
+fn surface_points_in_lanes_have_the_bits_of_one_at_a_time() {
+    let dir = crate::common::TempDir::new("seams-surface-lanes");
+    let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0.5\nv 2 2 2\nv 3 3 3\nv 4 4 4\n\
+               vn 0 0 1\nvn 0.2 0 1\nvn 0 -0.3 1\nvn 0 0 -1\nvt 0 0\nvt 1 0\nvt 0.5 1\n\
+               f 1/1/1 2/2/2 3/3/3\nf 2/2/4 4/1/1 3/3/2\nf 1 2 4\nf 5 6 7\nf 1//4 3//4 4//3\n";
+    let scene = Scene::load(&dir.write("mixed.obj", obj)).unwrap();
+    let triangles = scene.mesh.indices.len() as u32;
+    let mut rng = TestRng(23);
+    for isa in lumiere::accel::Isa::supported() {
+        let world = World::with_isa(scene.clone(), BuildPreset::Default, isa);
+        for _ in 0..2_000 {
+            let rays: [Ray; 16] = std::array::from_fn(|_| {
+                let dir = if rng.below(50) == 0 { Vec3::ZERO } else { rng.direction() };
+                Ray::new(rng.vec3(-2.0, 2.0), dir)
+            });
+            let hits: [Option<lumiere::accel::Hit>; 16] = std::array::from_fn(|_| {
+                (rng.below(8) != 0).then(|| lumiere::accel::Hit {
+                    t: 1.0,
+                    triangle: rng.below(triangles as usize) as u32,
+                    u: rng.range(-0.2, 1.1),
+                    v: rng.range(-0.2, 1.1),
+                })
+            });
+            let together = world.surfaces(&rays, &hits);
+            for lane in 0..16 {
+                let alone = hits[lane].map_or_else(Default::default, |hit| world.surface(&rays[lane], &hit));
+                let bits = |s: &lumiere::geometry::surface::SurfacePoint| {
+                    let floats = [s.p.to_array(), s.ng.to_array(), s.ns.to_array()].concat();
+                    (
+                        floats.iter().chain(&s.uv.to_array()).map(|x| x.to_bits()).collect::<Vec<_>>(),
+                        s.triangle,
+                        s.material,
+                        s.front_face,
+                    )
+                };
+                assert_eq!(
+                    bits(&together[lane]),
+                    bits(&alone),
+                    "{isa}: lane {lane}, hit {:?}, ray {:?}",
+                    hits[lane],
+                    rays[lane]
+                );
+            }
+        }
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Sample stream
 
