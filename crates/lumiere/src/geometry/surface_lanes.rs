@@ -56,6 +56,7 @@ impl<const N: usize> HitCorners<N> {
     /// `World::simd_256` so that the loop gets the ISA's width.
     #[inline(always)]
     pub fn surface_rows(&self) -> SurfaceRows<N> {
+        const { assert!(N <= 32, "the front-face mask is a u32") };
         // Locals, not the fields of the result: the compiler does not vectorise the loop when its
         // mask shares memory with its rows.
         let rows = [[0.0; N]; 3];
