@@ -216,6 +216,49 @@ fn random_meshes_match_brute_force_for_every_preset() {
     }
 }
 
+/// Trees large enough to be built in parallel (subtrees of 4,096 triangles and more split on rayon,
+/// then written into one array) are the same node for node on one thread and on three, keep their
+/// structure valid, and answer like brute force; some of the triangles are degenerate, so the
+/// build's compaction runs too.
+#[test]
+fn large_trees_are_the_same_on_any_thread_count_and_match_brute_force() {
+    let mut rng = TestRng(77);
+    let mut positions = Vec::new();
+    let mut indices = Vec::new();
+    for i in 0..20_000u32 {
+        let centre = rng.vec3(-10.0, 10.0);
+        let size = rng.range(0.01, 0.5);
+        let mut corners = [0; 3].map(|_| centre + rng.vec3(-size, size));
+        if i % 97 == 0 {
+            corners[2] = corners[0];
+        }
+        positions.extend(corners);
+        indices.push([3 * i, 3 * i + 1, 3 * i + 2]);
+    }
+    let build_on = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a thread pool");
+        pool.install(|| Bvh::build(&positions, &indices, BuildPreset::Default))
+    };
+    let (one, three) = (build_on(1), build_on(3));
+    assert_eq!(one.nodes(), three.nodes(), "the layout depends on the thread count");
+    assert_eq!(one.validate(), Ok(()));
+    let rays: Vec<Ray> = (0..400)
+        .map(|i| {
+            let origin = rng.vec3(-15.0, 15.0);
+            if i % 2 == 0 {
+                let target = positions[indices[rng.below(indices.len())][1] as usize];
+                Ray::new(origin, target - origin)
+            } else {
+                Ray::new(origin, rng.direction())
+            }
+        })
+        .collect();
+    for ray in &rays {
+        assert_eq!(one.intersect(ray), three.intersect(ray), "{ray:?}");
+    }
+    check_against_brute_force(&positions, &indices, &rays, "20,000 triangles");
+}
+
 #[test]
 fn closed_mesh_rays_through_vertices_and_edges_never_leak() {
     let (positions, indices) = grid_cube(6);

@@ -2,13 +2,15 @@
 //!
 //! Each node bins triangle centroids along all three axes, sweeps the bins for the split of least
 //! surface-area cost, and becomes a leaf when no split beats intersecting its triangles directly.
-//! Large subtrees are built in parallel with rayon and stitched into one array, so siblings stay
-//! adjacent and the layout is the same whatever the thread count.
+//! Large subtrees are built in parallel with rayon, then written once into one array, so siblings
+//! stay adjacent and the layout is the same whatever the thread count.
 //!
 //! Triangles travel as 32-byte references holding their box and id (Embree's `PrimRef`), which the
 //! partition moves: every pass reads memory in order, where an array of ids into a box array cost a
 //! cache miss per triangle in the top levels. The partition also gathers both sides' bounds, so a
 //! node never makes a pass of its own to find them.
+
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use glam::{Vec3, Vec3A};
 use rayon::prelude::*;
@@ -171,27 +173,36 @@ pub fn build<const W: usize>(
 ) -> Bvh {
     let corners = |t: &[u32; 3]| t.map(|i| positions[i as usize]);
     // Zero-area triangles have no surface and are never hit (see `is_degenerate`).
-    // Written in place by an indexed parallel map, then compacted: a parallel filter collects
-    // into pieces and copies them again (a tenth of the bunny-1m build).
+    // Written in place by an indexed parallel map, then compacted if any is degenerate (a
+    // serial pass): a parallel filter collects into pieces and copies them again (a tenth of the
+    // bunny-1m build).
+    let degenerate = AtomicBool::new(false);
     let mut refs: Vec<PrimRef> = indices
         .par_iter()
         .enumerate()
         .map(|(id, t)| {
             let [p0, p1, p2] = corners(t);
-            let id = if is_degenerate(p0, p1, p2) { DEGENERATE } else { id as u32 };
+            let id = if is_degenerate(p0, p1, p2) {
+                degenerate.store(true, Ordering::Relaxed);
+                DEGENERATE
+            } else {
+                id as u32
+            };
             let [a, b, c] = [p0, p1, p2].map(Vec3A::from);
             let (min, max) = (a.min(b).min(c), a.max(b).max(c));
             PrimRef { min: min.to_array(), id, max: max.to_array() }
         })
         .collect();
-    refs.retain(|r| r.id != DEGENERATE);
+    if degenerate.into_inner() {
+        refs.retain(|r| r.id != DEGENERATE);
+    }
     let ctx = Context::<W> { bins: preset.bins() };
 
     let nodes = if refs.is_empty() {
         vec![Node::new(Aabb::EMPTY, 0, 0)]
     } else {
         let bounds = NodeBounds::of(&refs);
-        build_subtree(&ctx, &mut refs, bounds, 0, 0)
+        build_subtree(&ctx, &mut refs, bounds, 0, 0).into_nodes()
     };
     let triangle_ids: Vec<u32> = refs.par_iter().map(|r| r.id).collect();
     let vertices = if copy_vertices {
@@ -202,22 +213,97 @@ pub fn build<const W: usize>(
     Bvh { nodes, vertices, triangle_ids, input_triangles: indices.len(), block_width: W }
 }
 
+/// A subtree as the parallel build returns it: built on one thread into an array of its own
+/// (root at 0), or a node whose two subtrees were built in parallel. [`Subtree::place`] then
+/// writes every node once into the tree's array; stitching the arrays together level by level
+/// copied each node once per parallel level (eight on the 1.1M-triangle bunny), into fresh pages.
+enum Subtree {
+    Local(Vec<Node>),
+    Split { bounds: Aabb, left: Box<Subtree>, right: Box<Subtree>, size: usize },
+}
+
+impl Subtree {
+    /// Nodes in the subtree, its root included.
+    fn size(&self) -> usize {
+        match self {
+            Subtree::Local(nodes) => nodes.len(),
+            Subtree::Split { size, .. } => *size,
+        }
+    }
+
+    /// Writes the root into `root` and the other nodes into `rest`, which starts at index
+    /// `rest_start` of the tree's array. The layout is the one [`build_into`] gives a subtree
+    /// built on one thread: a node's two children side by side, the left one's descendants next,
+    /// then the right one's.
+    fn place(self, root: &mut Node, rest: &mut [Node], rest_start: usize) {
+        debug_assert_eq!(rest.len() + 1, self.size());
+        match self {
+            Subtree::Local(nodes) => {
+                // Local index j > 0 moves to `rest_start + j - 1`; local 0 is `root`.
+                let relink = |node: Node| {
+                    if node.is_leaf() {
+                        return node;
+                    }
+                    Node { first: (rest_start + node.first as usize - 1) as u32, ..node }
+                };
+                *root = relink(nodes[0]);
+                for (slot, &node) in rest.iter_mut().zip(&nodes[1..]) {
+                    *slot = relink(node);
+                }
+            }
+            Subtree::Split { bounds, left, right, .. } => {
+                *root = Node::new(bounds, rest_start as u32, 0);
+                let (roots, descendants) = rest.split_at_mut(2);
+                let (left_root, right_root) = roots.split_at_mut(1);
+                let left_size = left.size();
+                let (left_rest, right_rest) = descendants.split_at_mut(left_size - 1);
+                let (left_start, right_start) = (rest_start + 2, rest_start + 1 + left_size);
+                rayon::join(
+                    || left.place(&mut left_root[0], left_rest, left_start),
+                    || right.place(&mut right_root[0], right_rest, right_start),
+                );
+            }
+        }
+    }
+
+    /// The tree's node array, root at 0.
+    fn into_nodes(self) -> Vec<Node> {
+        let mut nodes = vec![Node::default(); self.size()];
+        let (root, rest) = nodes.split_at_mut(1);
+        self.place(&mut root[0], rest, 1);
+        nodes
+    }
+}
+
 /// Builds the subtree over `refs` (whose bounds are `bounds`, and whose first element is triangle
-/// slot `offset` in leaf order) into a node array whose root is at index 0.
+/// slot `offset` in leaf order): large ones split in parallel, the rest on this thread.
 fn build_subtree<const W: usize>(
     ctx: &Context<W>,
     refs: &mut [PrimRef],
     bounds: NodeBounds,
     offset: usize,
     depth: usize,
-) -> Vec<Node> {
+) -> Subtree {
+    if refs.len() >= PARALLEL_THRESHOLD
+        && let Some((mid, left_bounds, right_bounds)) =
+            choose_split(ctx, refs, &bounds.bounds.to_aabb(), &bounds.centroids.to_aabb(), depth)
+    {
+        let (left, right) = refs.split_at_mut(mid);
+        let (left, right) = rayon::join(
+            || build_subtree(ctx, left, left_bounds, offset, depth + 1),
+            || build_subtree(ctx, right, right_bounds, offset + mid, depth + 1),
+        );
+        let size = 1 + left.size() + right.size();
+        return Subtree::Split { bounds: bounds.bounds.to_aabb(), left: Box::new(left), right: Box::new(right), size };
+    }
     let mut nodes = Vec::with_capacity(refs.len());
     nodes.push(Node::default());
     build_into(ctx, refs, bounds, offset, depth, 0, &mut nodes);
-    nodes
+    Subtree::Local(nodes)
 }
 
-/// Fills node `index` of `nodes` for the triangles `refs`, appending its descendants.
+/// Fills node `index` of `nodes` for the triangles `refs`, appending its descendants (on this
+/// thread).
 fn build_into<const W: usize>(
     ctx: &Context<W>,
     refs: &mut [PrimRef],
@@ -237,40 +323,10 @@ fn build_into<const W: usize>(
     let (left, right) = refs.split_at_mut(mid);
     let first_child = nodes.len();
     nodes[index] = Node::new(bounds, first_child as u32, 0);
-
-    if left.len() + right.len() >= PARALLEL_THRESHOLD {
-        let (left_nodes, right_nodes) = rayon::join(
-            || build_subtree(ctx, left, left_bounds, offset, depth + 1),
-            || build_subtree(ctx, right, right_bounds, offset + mid, depth + 1),
-        );
-        stitch(nodes, first_child, left_nodes, right_nodes);
-    } else {
-        nodes.push(Node::default());
-        nodes.push(Node::default());
-        build_into(ctx, left, left_bounds, offset, depth + 1, first_child, nodes);
-        build_into(ctx, right, right_bounds, offset + mid, depth + 1, first_child + 1, nodes);
-    }
-}
-
-/// Appends two independently built subtrees so that their roots land at `first_child` and
-/// `first_child + 1` (adjacent siblings), renumbering their interior child links.
-fn stitch(nodes: &mut Vec<Node>, first_child: usize, left: Vec<Node>, right: Vec<Node>) {
-    debug_assert_eq!(nodes.len(), first_child);
-    let left_rest = first_child + 2;
-    let right_rest = left_rest + left.len() - 1;
-    // Local index j > 0 of a subtree moves to its block; local 0 is the root placed beside its sibling.
-    let relink = |node: Node, root: usize, rest: usize| -> Node {
-        if node.is_leaf() {
-            return node;
-        }
-        let j = node.first as usize;
-        let first = if j == 0 { root } else { rest + j - 1 };
-        Node { first: first as u32, ..node }
-    };
-    nodes.push(relink(left[0], first_child, left_rest));
-    nodes.push(relink(right[0], first_child + 1, right_rest));
-    nodes.extend(left[1..].iter().map(|&n| relink(n, first_child, left_rest)));
-    nodes.extend(right[1..].iter().map(|&n| relink(n, first_child + 1, right_rest)));
+    nodes.push(Node::default());
+    nodes.push(Node::default());
+    build_into(ctx, left, left_bounds, offset, depth + 1, first_child, nodes);
+    build_into(ctx, right, right_bounds, offset + mid, depth + 1, first_child + 1, nodes);
 }
 
 /// Decides whether to split `refs`; if so, partitions it in place and returns the size of the left

@@ -34,7 +34,11 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
         // kernel this CPU cannot run.
         assert!(L::supported(), "this CPU cannot run the kernel of a {W}-wide BVH");
 
-        let (blocks, first_block_of_leaf) = leaf_blocks::<W>(bvh, &corners);
+        let root = &bvh.nodes()[0];
+        let lone_leaf = root.is_leaf() || bvh.triangle_count() == 0;
+        // The plan reads only the binary nodes: it is worked out while the blocks are filled.
+        let ((blocks, first_block_of_leaf), plan) =
+            rayon::join(|| leaf_blocks::<W>(bvh, &corners), || (!lone_leaf).then(|| CollapsePlan::<W>::new(bvh)));
         // Each wide node takes at least one binary interior node: room for all, reserved, not touched.
         let interior = bvh.nodes().len() - first_block_of_leaf.iter().filter(|&&b| b != NOT_A_LEAF).count();
         let mut wide = WideBvh {
@@ -43,17 +47,15 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
             triangle_count: bvh.triangle_count(),
             kernel: PhantomData,
         };
-        let root = &bvh.nodes()[0];
-        if root.is_leaf() || bvh.triangle_count() == 0 {
+        if let Some(plan) = plan {
+            wide.collapse(bvh, &plan, &first_block_of_leaf, 0);
+        } else {
             // A lone leaf (or nothing) still needs a wide root node to hang from.
             wide.nodes.push(WideNode::empty());
             if bvh.triangle_count() > 0 {
                 let leaf = leaf::encode::<W>(0, wide.blocks.len());
                 set_child(&mut wide.nodes[0], 0, leaf, root);
             }
-        } else {
-            let plan = CollapsePlan::<W>::new(bvh);
-            wide.collapse(bvh, &plan, &first_block_of_leaf, 0);
         }
         wide
     }
