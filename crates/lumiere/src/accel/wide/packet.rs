@@ -71,6 +71,14 @@ pub struct RayPacket<const N: usize> {
     tmax: [f32; N],
 }
 
+/// The origin that all of a packet's rays start from, and the range of each axis's reciprocal
+/// direction over the lanes: enough to bound every lane's slab test of a box at once.
+struct SharedOrigin {
+    origin: [f32; 3],
+    /// Per axis, the least and the greatest reciprocal of any lane.
+    inv_dir: [[f32; 2]; 3],
+}
+
 impl<const N: usize> RayPacket<N> {
     /// The packet of `rays`, which must all have the key `key` (lanes a caller leaves out repeat
     /// a ray that does). The reciprocals and shears of `safe_reciprocal` and `WatertightRay`,
@@ -107,6 +115,65 @@ impl<const N: usize> RayPacket<N> {
             packet.shear[2][lane] = 1.0 / d[2];
         }
         packet
+    }
+
+    /// The packet's shared origin and reciprocal ranges, if every lane starts at the same point (a
+    /// pinhole camera's rays do).
+    #[inline(always)]
+    fn shared_origin(&self) -> Option<SharedOrigin> {
+        // Plain loops: closures passed to `array::map` were left out of line, outside the ISA.
+        let mut shared = SharedOrigin { origin: [0.0; 3], inv_dir: [[f32::INFINITY, f32::NEG_INFINITY]; 3] };
+        for axis in 0..3 {
+            let origin = self.origin[axis][0];
+            let mut same = true;
+            for lane in 0..N {
+                same &= self.origin[axis][lane].to_bits() == origin.to_bits();
+                let inv_dir = self.inv_dir[axis][lane];
+                let [least, greatest] = &mut shared.inv_dir[axis];
+                (*least, *greatest) = (least.min(inv_dir), greatest.max(inv_dir));
+            }
+            if !same {
+                return None;
+            }
+            shared.origin[axis] = origin;
+        }
+        Some(shared)
+    }
+
+    /// For a packet whose rays share their origin (`shared`, from [`RayPacket::shared_origin`]), the
+    /// children of `node` that some lane may enter before its `limit` (bit per child). Never leaves out a child that a
+    /// lane's [`RayPacket::enter`] enters: with one origin, each plane's distance is the same
+    /// number `d` for every lane, and a lane's entry `d * inv_dir`, rounded, moves monotonically
+    /// with its `inv_dir` (its exit `d * inv_dir * BOX_EXPANSION` too), so the lanes of the least
+    /// and the greatest `inv_dir` bound all of them: a child whose least entry comes after its
+    /// greatest exit is entered by none. One test for the `W` children spares the per-lane tests
+    /// of the many children that a narrow packet misses, deep in the tree.
+    #[inline(always)]
+    fn children_entered_by_some<const W: usize>(
+        &self,
+        shared: &SharedOrigin,
+        node: &WideNode<W>,
+        limit: &[f32; N],
+    ) -> u32 {
+        let farthest = limit.iter().fold(f32::NEG_INFINITY, |a, &b| max_ps(a, b));
+        let mut near = [0.0f32; W];
+        let mut far = [farthest; W];
+        for axis in 0..3 {
+            let near_row = self.near_rows[axis];
+            let (near_planes, far_planes) = (&node.bounds[near_row], &node.bounds[(near_row + 3) % 6]);
+            let [least, greatest] = shared.inv_dir[axis];
+            let origin = shared.origin[axis];
+            for child in 0..W {
+                let (to_near, to_far) = (near_planes[child] - origin, far_planes[child] - origin);
+                let entry = (to_near * least).min(to_near * greatest);
+                let exit = (to_far * least * BOX_EXPANSION).max(to_far * greatest * BOX_EXPANSION);
+                near[child] = max_ps(near[child], entry);
+                far[child] = min_ps(far[child], exit);
+            }
+        }
+        // Kept unless the entry surely comes after the exit (a NaN, an empty slot's, decides nothing).
+        let kept = |child: usize| near[child].partial_cmp(&far[child]) != Some(std::cmp::Ordering::Greater);
+        (0..W).fold(0, |mask, child| mask | u32::from(kept(child)) << child)
     }
 
     /// Lane `lane`'s ray, for the scalar test's f64 fallbacks.
@@ -199,13 +266,16 @@ impl<const N: usize> Closest<N> {
 fn push_children<const N: usize, const W: usize>(
     stack: &mut Stack<W>,
     packet: &RayPacket<N>,
+    shared: Option<&SharedOrigin>,
     node: &WideNode<W>,
     limit: &[f32; N],
 ) {
     let mut entered = [(0u32, 0f32); W];
     let mut count = 0;
+    let candidates = shared.map_or(u32::MAX, |shared| packet.children_entered_by_some(shared, node, limit));
     for child in 0..W {
-        if node.children[child] == EMPTY_CHILD {
+        if node.children[child] == EMPTY_CHILD || candidates & (1 << child) == 0 {
+            debug_assert!(node.children[child] == EMPTY_CHILD || packet.enter(node, child, limit).0 == 0);
             continue;
         }
         let (mask, nearest) = packet.enter(node, child, limit);
@@ -362,6 +432,7 @@ impl<const W: usize, L> WideBvh<W, L> {
         let mut out = [[0.0f32; N]; 3];
         let use_boxes = BoxFirst::for_next_packet();
         let (mut boxes_tested, mut boxes_ruled_out) = (0u32, 0u32);
+        let shared = packet.shared_origin();
         while let Some((reference, nearest)) = stack.pop() {
             // No lane can find anything closer in there (the single-ray pruning, for the packet).
             if nearest > farthest_limit * PRUNE_SLACK {
@@ -369,7 +440,7 @@ impl<const W: usize, L> WideBvh<W, L> {
             }
             let limit = tmax.map(|t| t * PRUNE_SLACK);
             if reference & LEAF_BIT == 0 {
-                push_children(&mut stack, packet, &self.nodes[reference as usize], &limit);
+                push_children(&mut stack, packet, shared.as_ref(), &self.nodes[reference as usize], &limit);
                 continue;
             }
             for block in &self.blocks[leaf::blocks::<W>(reference)] {
@@ -429,7 +500,8 @@ impl<const W: usize, L> WideBvh<W, L> {
         let (mut boxes_tested, mut boxes_ruled_out) = (0u32, 0u32);
         while let Some((reference, _)) = stack.pop() {
             if reference & LEAF_BIT == 0 {
-                push_children(&mut stack, packet, &self.nodes[reference as usize], &limit);
+                // Shadow packets share an end point, not an origin: no node test for them.
+                push_children(&mut stack, packet, None, &self.nodes[reference as usize], &limit);
                 continue;
             }
             for block in &self.blocks[leaf::blocks::<W>(reference)] {
@@ -465,6 +537,61 @@ impl<const W: usize, L> WideBvh<W, L> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The node test of a packet whose rays share their origin keeps every child that a lane's own
+    /// slab test enters, down to the last bit: boxes flat on an axis (walls), rays aimed exactly
+    /// at box corners (where entry and exit meet and only `BOX_EXPANSION` lets the ray in), lanes
+    /// a few ulps apart, short and infinite limits.
+    #[test]
+    fn a_shared_origin_node_test_keeps_every_child_a_lane_enters() {
+        let mut state = 0x9E37_79B9_7F4A_7C15u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let (mut checked, mut entered) = (0, 0);
+        for _ in 0..4000 {
+            let mut node = WideNode::<8>::empty();
+            for child in 0..8 {
+                let centre = [0, 1, 2].map(|_| next() * 2.0 - 1.0);
+                let flat = (next() * 4.0) as usize;
+                for (axis, centre) in centre.into_iter().enumerate() {
+                    let half = if axis == flat { 0.0 } else { next() * 0.5 };
+                    node.bounds[axis][child] = centre - half;
+                    node.bounds[axis + 3][child] = centre + half;
+                }
+                node.children[child] = child as u32;
+            }
+            let origin = Vec3::new(next() * 20.0 - 10.0, next() * 20.0 - 10.0, 8.0 + next() * 4.0);
+            // Every lane aimed at one corner of one child, a few ulps apart, or all exactly there.
+            let child = (next() * 8.0) as usize;
+            let corner: [f32; 3] = [0, 1, 2].map(|axis| node.bounds[axis + 3 * usize::from(next() < 0.5)][child]);
+            let ulps = (next() * 3.0) as u32;
+            let rays: [Ray; 16] = std::array::from_fn(|lane| {
+                let aim = corner.map(|c| f32::from_bits(c.to_bits().wrapping_add(lane as u32 % 2 * ulps)));
+                Ray::new(origin, Vec3::from_array(aim) - origin)
+            });
+            let key = PacketKey::of(&rays[0]);
+            if rays.iter().any(|ray| PacketKey::of(ray) != key) {
+                continue;
+            }
+            let packet = RayPacket::new(key, &rays);
+            let limit: [f32; 16] =
+                std::array::from_fn(|lane| if lane % 4 == 0 { 30.0 * next() } else { f32::INFINITY });
+            let shared = packet.shared_origin().expect("one origin");
+            let candidates = packet.children_entered_by_some(&shared, &node, &limit);
+            for child in 0..8 {
+                checked += 1;
+                if packet.enter(&node, child, &limit).0 != 0 {
+                    entered += 1;
+                    assert!(candidates & (1 << child) != 0, "child {child} of {node:?} left out for {rays:?}");
+                }
+            }
+        }
+        assert!(checked > 10_000 && entered > 2_000, "{checked} children checked, {entered} entered");
+    }
 
     /// The key's permutation and the packet's shears are `WatertightRay`'s, for directions along
     /// and between the axes, of either sign, zero components included.
