@@ -112,13 +112,7 @@ mod tests {
 
     /// A binary tree over `count` small scattered triangles (a fixed pseudo-random scene).
     fn scattered_tree<const W: usize>(count: usize) -> Bvh {
-        let mut state = 0x2545_F491_4F6C_DD1Du64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut next = crate::accel::wide::unit_floats(0x2545_F491_4F6C_DD1Du64);
         let mut positions = Vec::new();
         let mut indices = Vec::new();
         for i in 0..count as u32 {

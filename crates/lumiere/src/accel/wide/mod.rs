@@ -62,3 +62,15 @@ impl<const W: usize, L> WideBvh<W, L> {
         self.nodes.len() * size_of::<WideNode<W>>() + self.blocks.len() * size_of::<TriangleBlock<W>>()
     }
 }
+
+/// Fixed pseudo-random numbers in `[0, 1)` for the unit tests (xorshift64, 24 bits a number).
+#[cfg(test)]
+fn unit_floats(seed: u64) -> impl FnMut() -> f32 {
+    let mut state = seed;
+    move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 40) as f32 / (1u64 << 24) as f32
+    }
+}

@@ -544,13 +544,7 @@ mod tests {
     /// a few ulps apart, short and infinite limits.
     #[test]
     fn a_shared_origin_node_test_keeps_every_child_a_lane_enters() {
-        let mut state = 0x9E37_79B9_7F4A_7C15u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut next = crate::accel::wide::unit_floats(0x9E37_79B9_7F4A_7C15u64);
         let (mut checked, mut entered) = (0, 0);
         for _ in 0..4000 {
             let mut node = WideNode::<8>::empty();
