@@ -140,14 +140,17 @@ impl<const N: usize> RayPacket<N> {
         Some(shared)
     }
 
-    /// For a packet whose rays share their origin (`shared`, from [`RayPacket::shared_origin`]), the
-    /// children of `node` that some lane may enter before its `limit` (bit per child). Never leaves out a child that a
-    /// lane's [`RayPacket::enter`] enters: with one origin, each plane's distance is the same
-    /// number `d` for every lane, and a lane's entry `d * inv_dir`, rounded, moves monotonically
-    /// with its `inv_dir` (its exit `d * inv_dir * BOX_EXPANSION` too), so the lanes of the least
-    /// and the greatest `inv_dir` bound all of them: a child whose least entry comes after its
-    /// greatest exit is entered by none. One test for the `W` children spares the per-lane tests
-    /// of the many children that a narrow packet misses, deep in the tree.
+    /// For a packet whose rays share their origin (`shared`, from [`RayPacket::shared_origin`]),
+    /// the children of `node` that some lane may enter before its `limit` (bit per child).
+    ///
+    /// Never leaves out a child that a lane's [`RayPacket::enter`] enters: with one origin, each
+    /// plane's distance is the same number `d` for every lane, and a lane's entry `d * inv_dir`,
+    /// rounded, moves monotonically with its `inv_dir` (its exit `d * inv_dir * BOX_EXPANSION`
+    /// too), so the lanes of the least and the greatest `inv_dir` bound all of them: a child whose
+    /// least entry comes after its greatest exit is entered by none. One test for the `W` children
+    /// spares the per-lane tests of the many children that a narrow packet misses, deep in the
+    /// tree. (Bounding shadow packets, whose origins differ, by the corners of an origin interval
+    /// too made them slower: hard shadows +14%.)
     #[inline(always)]
     fn children_entered_by_some<const W: usize>(
         &self,
