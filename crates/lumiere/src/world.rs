@@ -306,6 +306,8 @@ impl World {
         for (lane, hit) in hits.iter().enumerate() {
             let Some(hit) = hit else { continue };
             let id = hit.triangle as usize;
+            // Straight from the index arrays into the rows: through `TriangleMesh::corner_normals`
+            // (a copy of the three values first) hard shadows took 2-7% longer.
             let gather = |corners: &mut [Rows<N>; 3], values: &[Vec3], indices: [u32; 3]| {
                 for (rows, index) in corners.iter_mut().zip(indices) {
                     set_row(rows, lane, values[index as usize]);
@@ -341,21 +343,11 @@ impl World {
     }
 
     fn interpolated_normal(&self, id: usize, w: f32, u: f32, v: f32) -> Option<Vec3> {
-        let mesh = &self.scene.mesh;
-        let [a, b, c] = *mesh.normal_indices.get(id)?;
-        if a == NO_INDEX || b == NO_INDEX || c == NO_INDEX {
-            return None;
-        }
-        let n = w * mesh.normals[a as usize] + u * mesh.normals[b as usize] + v * mesh.normals[c as usize];
-        n.try_normalize()
+        let [a, b, c] = self.scene.mesh.corner_normals(id)?;
+        (w * a + u * b + v * c).try_normalize()
     }
 
     fn interpolated_texcoord(&self, id: usize, w: f32, u: f32, v: f32) -> Vec2 {
-        let mesh = &self.scene.mesh;
-        let Some(&[a, b, c]) = mesh.texcoord_indices.get(id) else { return Vec2::ZERO };
-        if a == NO_INDEX || b == NO_INDEX || c == NO_INDEX {
-            return Vec2::ZERO;
-        }
-        w * mesh.texcoords[a as usize] + u * mesh.texcoords[b as usize] + v * mesh.texcoords[c as usize]
+        self.scene.mesh.corner_texcoords(id).map_or(Vec2::ZERO, |[a, b, c]| w * a + u * b + v * c)
     }
 }

@@ -48,4 +48,25 @@ impl TriangleMesh {
         let [a, b, c] = self.indices[id];
         [self.positions[a as usize], self.positions[b as usize], self.positions[c as usize]]
     }
+
+    /// The three corner normals of triangle `id`, if the file gave all of them.
+    #[inline(always)]
+    pub fn corner_normals(&self, id: usize) -> Option<[Vec3; 3]> {
+        corners(&self.normals, self.normal_indices.get(id)?)
+    }
+
+    /// The three corner texture coordinates of triangle `id`, if the file gave all of them.
+    #[inline(always)]
+    pub fn corner_texcoords(&self, id: usize) -> Option<[Vec2; 3]> {
+        corners(&self.texcoords, self.texcoord_indices.get(id)?)
+    }
+}
+
+/// The values of `indices`, unless one is [`NO_INDEX`].
+#[inline(always)]
+fn corners<T: Copy>(values: &[T], &[a, b, c]: &[u32; 3]) -> Option<[T; 3]> {
+    if a == NO_INDEX || b == NO_INDEX || c == NO_INDEX {
+        return None;
+    }
+    Some([values[a as usize], values[b as usize], values[c as usize]])
 }
