@@ -158,6 +158,8 @@ impl<const N: usize> RayPacket<N> {
         node: &WideNode<W>,
         limit: &[f32; N],
     ) -> u32 {
+        // The closest-hit walk knows this maximum already (`farthest_limit`), but passing it in
+        // made Cornell hits 33 -> 41 ms: the fold over the lanes in registers costs less.
         let farthest = limit.iter().fold(f32::NEG_INFINITY, |a, &b| max_ps(a, b));
         let mut near = [0.0f32; W];
         let mut far = [farthest; W];
