@@ -113,7 +113,9 @@ fn check_against_brute_force(positions: &[Vec3], indices: &[[u32; 3]], rays: &[R
                 assert_eq!(accel.occluded_counted(ray, &mut stats), expected.is_some(), "{context} {isa} counted");
             }
         }
-        assert!(rays.is_empty() || indices.is_empty() || stats.nodes > 0, "{context}: counters count");
+        // A tree of one node over at most four blocks is tested block by block, visiting no node.
+        assert!(rays.is_empty() || indices.is_empty() || stats.blocks > 0, "{context}: counters count blocks");
+        assert!(rays.is_empty() || wide.nodes().len() == 1 || stats.nodes > 0, "{context}: counters count nodes");
         check_packets(&accels, positions, indices, rays, &format!("{context} {preset:?}"));
     }
 }
@@ -282,6 +284,39 @@ fn closed_mesh_rays_through_vertices_and_edges_never_leak() {
         }
     }
     check_against_brute_force(&positions, &indices, &rays, "grid cube");
+}
+
+/// The Cornell box (32 triangles: one 8-wide node over four blocks) is tested block by block
+/// without its node, by single rays from inside and outside, some along its edges: brute force's
+/// answers on every ISA, every block tested, no node.
+#[test]
+fn a_one_node_tree_tested_block_by_block_answers_like_brute_force() {
+    let mesh = lumiere::scene::Scene::builtin().unwrap().mesh;
+    let (positions, indices) = (&mesh.positions, &mesh.indices);
+    let mut rng = TestRng(32);
+    let inside = Vec3::new(0.0, 1.0, 0.0);
+    let mut rays: Vec<Ray> = positions.iter().map(|&p| Ray::new(inside, p - inside)).collect();
+    rays.extend((0..2000).map(|_| Ray::new(inside + rng.vec3(-0.9, 0.9), rng.direction())));
+    rays.extend((0..2000).map(|_| {
+        let origin = rng.vec3(-5.0, 5.0);
+        Ray::new(origin, positions[indices[rng.below(indices.len())][1] as usize] - origin)
+    }));
+    for ray in rays.iter_mut().step_by(3) {
+        ray.tmax = rng.range(0.0, 2.0);
+    }
+    let expected: Vec<Option<Hit>> = rays.iter().map(|ray| brute_force(positions, indices, ray)).collect();
+    let hits = expected.iter().filter(|hit| hit.is_some()).count();
+    assert!(hits > rays.len() / 2, "most rays hit ({hits} of {})", rays.len());
+    for isa in Isa::supported().into_iter().filter(|&isa| isa >= Isa::Avx2) {
+        let accel = Accel::build(positions, indices, BuildPreset::default(), isa);
+        for (ray, &expected) in rays.iter().zip(&expected) {
+            let mut stats = TraversalStats::default();
+            assert_eq!(accel.intersect_counted(ray, &mut stats), expected, "{isa} {ray:?}");
+            assert_eq!(accel.intersect(ray), expected, "{isa} {ray:?}");
+            assert_eq!((stats.nodes, stats.blocks), (0, 4), "{isa}: every block, no node");
+            assert_eq!(accel.occluded(ray), expected.is_some(), "{isa} occlusion {ray:?}");
+        }
+    }
 }
 
 #[test]
