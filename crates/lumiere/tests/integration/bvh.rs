@@ -287,7 +287,7 @@ fn closed_mesh_rays_through_vertices_and_edges_never_leak() {
 }
 
 /// The Cornell box (32 triangles: one 8-wide node over four blocks) is tested block by block
-/// without its node, by single rays from inside and outside, some along its edges: brute force's
+/// without its node, by single rays from inside and outside, some through its vertices: brute force's
 /// answers on every ISA, every block tested, no node.
 #[test]
 fn a_one_node_tree_tested_block_by_block_answers_like_brute_force() {

@@ -237,8 +237,8 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
     /// The blocks of a tree small enough to test every one of them, in order: one node (its
     /// children all leaves) over at most [`FLAT_BLOCKS`] blocks. There the walk culls too little to
     /// pay for its box test, the ordering of the children and the stack: single rays on the
-    /// Cornell box's 32 triangles (four blocks of eight) took 19% less time tested against all
-    /// four blocks (`lumiere bench-bvh --scenes cornell`, diffuse closest hits and occlusion).
+    /// Cornell box's 32 triangles (four blocks of eight) took 15-21% less time tested against all
+    /// four blocks (`lumiere bench-bvh --scenes cornell`: primary, shadow and diffuse rays).
     #[inline(always)]
     fn flat_blocks(&self) -> Option<&[TriangleBlock<W>]> {
         (self.nodes.len() == 1 && self.blocks.len() <= FLAT_BLOCKS).then_some(&self.blocks[..])
