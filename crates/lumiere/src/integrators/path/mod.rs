@@ -192,13 +192,14 @@ impl Path {
         let diffuse_together = world.isa() >= Isa::Avx2;
         while live != 0 {
             *rays += u64::from(live.count_ones());
-            let hits: [Option<Hit>; N] = std::array::from_fn(|lane| {
-                let hit = if live & (1 << lane) != 0 { world.intersect(&paths[lane].ray) } else { None };
-                if let Some(hit) = &hit {
+            // A plain loop: closures passed to `array::from_fn` may be left out of line.
+            let mut hits: [Option<Hit>; N] = [None; N];
+            for lane in lanes_of(live) {
+                hits[lane] = world.intersect(&paths[lane].ray);
+                if let Some(hit) = &hits[lane] {
                     world.prefetch_hit(hit);
                 }
-                hit
-            });
+            }
             for lane in lanes_of(live) {
                 match hits[lane] {
                     Some(hit) if self.arrive(world, &mut paths[lane], &hit) => {
