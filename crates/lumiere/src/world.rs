@@ -336,10 +336,13 @@ impl World {
             #[inline(always)]
             || corners.surface_rows(),
         );
-        std::array::from_fn(|lane| match hits[lane] {
-            Some(hit) => rows.point(lane, hit.triangle, mesh.material_ids[hit.triangle as usize]),
-            None => SurfacePoint::default(),
-        })
+        let mut points = [SurfacePoint::default(); N];
+        for (lane, hit) in hits.iter().enumerate() {
+            if let Some(hit) = hit {
+                points[lane] = rows.point(lane, hit.triangle, mesh.material_ids[hit.triangle as usize]);
+            }
+        }
+        points
     }
 
     fn interpolated_normal(&self, id: usize, w: f32, u: f32, v: f32) -> Option<Vec3> {
