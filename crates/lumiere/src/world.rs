@@ -336,6 +336,7 @@ impl World {
             #[inline(always)]
             || corners.surface_rows(),
         );
+        // A plain loop: through `array::from_fn` the points were a call per lane (materials 6% slower).
         let mut points = [SurfacePoint::default(); N];
         for (lane, hit) in hits.iter().enumerate() {
             if let Some(hit) = hit {
