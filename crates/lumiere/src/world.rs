@@ -36,10 +36,31 @@ pub struct World {
     warnings: Vec<String>,
     /// The diagonal of the scene's bounding box: no two of its points lie farther apart.
     diameter: f32,
+    /// For each light, the triangles that may block a segment ending at its hard-shadow target
+    /// ([`World::hard_shadow_batch`]); empty where no light's would be gathered.
+    hard_shadow_batches: Vec<OriginBatch>,
     /// Whether the records shading reads (the mesh's, the textures') outgrow a core's caches, so
     /// that asking for them ahead ([`World::prefetch_hit`], [`World::prefetch_bsdf`]) pays:
     /// where they all stay cached (the Cornell box), the requests only cost.
     prefetches: bool,
+}
+
+/// Each light's [`World::hard_shadow_batch`], or none if no light's candidates were gathered.
+fn hard_shadow_batches(accel: &Accel, lights: &LightSet) -> Vec<OriginBatch> {
+    let batches: Vec<OriginBatch> = lights
+        .lights()
+        .iter()
+        .map(|light| {
+            let target = light.hard_shadow_target();
+            // Split into quarters (as ambient occlusion does), the box's were tested against about
+            // half as many triangles each, but the render took as long.
+            let region = Region::hemisphere(target, light.normal);
+            let mut batch = OriginBatch::default();
+            accel.prepare_batch(&mut batch, target, &region, u32::MAX);
+            batch
+        })
+        .collect();
+    if batches.iter().all(OriginBatch::traverses) { Vec::new() } else { batches }
 }
 
 /// The shading data above which [`World::prefetch_hit`] and [`World::prefetch_bsdf`] ask for
@@ -68,6 +89,7 @@ impl World {
         warnings.extend(cutout_warnings);
         let diameter = scene.bounds().extent().length();
         let prefetches = scene.mesh.memory_bytes() + textures.memory_bytes() > PREFETCH_ABOVE_BYTES;
+        let hard_shadow_batches = if cutouts.is_empty() { hard_shadow_batches(&accel, &lights) } else { Vec::new() };
         World {
             scene,
             accel,
@@ -79,8 +101,19 @@ impl World {
             cutouts,
             warnings,
             diameter,
+            hard_shadow_batches,
             prefetches,
         }
+    }
+
+    /// The candidate triangles of the segments that end at light `light`'s hard-shadow target
+    /// ([`crate::lights::AreaLight::hard_shadow_target`]), read backwards as rays leaving it into the half-space
+    /// in front of the light: every such segment of an image leaves from that one point, so the
+    /// batch is gathered once for the whole render, not once per receiver. `None` where the
+    /// candidates were not gathered (a large scene, cutouts: see [`OriginBatch::prepare`]).
+    #[inline]
+    pub fn hard_shadow_batch(&self, light: usize) -> Option<&OriginBatch> {
+        self.hard_shadow_batches.get(light).filter(|batch| !batch.traverses())
     }
 
     pub fn scene(&self) -> &Scene {

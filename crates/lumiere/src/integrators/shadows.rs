@@ -1,8 +1,8 @@
 use glam::Vec3;
 
 use super::{CameraPacket, Integrator, PACKET, SampleContext, shading_frame};
-use crate::accel::Hit;
-use crate::accel::simd::lanes_of;
+use crate::accel::simd::{all_lanes, lanes_of};
+use crate::accel::{Hit, OriginBatch};
 use crate::geometry::surface::SurfacePoint;
 use crate::lights::AreaLight;
 use crate::materials::{Bsdf, MaterialBsdf};
@@ -25,10 +25,11 @@ impl Integrator for Shadows {
             Err(radiance) => return radiance,
         };
         let mut sum = Vec3::ZERO;
-        for light in world.lights().lights() {
-            if let Some((segment, contribution)) = receiver.unshadowed(light, &LightPoint::of(light)) {
+        for (index, light) in world.lights().lights().iter().enumerate() {
+            let point = LightPoint::of(world, index, light);
+            if let Some((segment, contribution)) = receiver.unshadowed(light, &point) {
                 ctx.rays += 1;
-                if !world.occluded(&segment) {
+                if !point.occluded(world, &segment) {
                     sum += contribution;
                 }
             }
@@ -37,8 +38,10 @@ impl Integrator for Shadows {
     }
 
     /// The camera rays of the block as a packet, then for each light the block's shadow rays
-    /// towards its centroid as a packet: they share an end point, so they are as coherent as the
-    /// camera rays. Each lane adds its lights in the same order as `radiance`: the same bits.
+    /// towards its centroid together: read backwards, as rays from that point, against the
+    /// light's batch of candidates ([`World::hard_shadow_batch`]), or else as a packet (they share
+    /// an end point, so they are as coherent as the camera rays). Each lane adds its lights in the
+    /// same order as `radiance`, and asks the same test: the same bits.
     ///
     /// Diffuse receivers (all of the lab's) are lit together, SoA ([`DiffuseLanes`]); any other
     /// is lit one at a time by its [`Receiver`].
@@ -63,9 +66,13 @@ impl Integrator for Shadows {
         }
         let mut segments = camera.rays;
         let mut contributions = [Vec3::ZERO; PACKET];
-        for light in world.lights().lights() {
-            let point = LightPoint::of(light);
-            let mut traced = diffuse.unshadowed(light, &point, &mut segments, &mut contributions);
+        for (index, light) in world.lights().lights().iter().enumerate() {
+            let point = LightPoint::of(world, index, light);
+            // In the ISA's width: the lane loop's square roots and divisions, 16 at a time.
+            let mut traced = world.simd(
+                #[inline(always)]
+                || diffuse.unshadowed(light, &point, &mut segments, &mut contributions),
+            );
             for (lane, receiver) in others.iter().enumerate() {
                 if let Some((segment, contribution)) = receiver.as_ref().and_then(|r| r.unshadowed(light, &point)) {
                     (segments[lane], contributions[lane]) = (segment, contribution);
@@ -76,7 +83,7 @@ impl Integrator for Shadows {
                 continue;
             }
             ctx.rays += u64::from(traced.count_ones());
-            let lit = traced & !world.occluded_packet(&segments, traced);
+            let lit = traced & !point.occluded_lanes(world, &segments, traced);
             for lane in lanes_of(lit) {
                 radiance[lane] += contributions[lane];
             }
@@ -120,7 +127,7 @@ impl DiffuseLanes {
     /// contributions of the lanes the light can reach into `segments` and `contributions`, and
     /// returns those lanes. Each lane does `unshadowed`'s operations in its order (glam's `dot`
     /// and `length_squared` sum x, y, then z), so the bits are its.
-    #[inline]
+    #[inline(always)]
     fn unshadowed(
         &self,
         light: &AreaLight,
@@ -174,16 +181,80 @@ impl DiffuseLanes {
 }
 
 /// Where a light triangle acts as a point light: its centroid, and the point on its shadow-target
-/// triangle the shadow segments end at. The same for every receiver: computed once per light.
-struct LightPoint {
+/// triangle the shadow segments end at, with what tests them. The same for every receiver:
+/// computed once per light.
+struct LightPoint<'w> {
     centroid: Vec3,
     target: Vec3,
+    /// The light's normal: the side of `target` the segments' batch covers.
+    normal: Vec3,
+    /// The triangles that may block a segment ending at `target`, if gathered.
+    batch: Option<&'w OriginBatch>,
 }
 
-impl LightPoint {
+impl<'w> LightPoint<'w> {
     #[inline]
-    fn of(light: &AreaLight) -> LightPoint {
-        LightPoint { centroid: light.centroid(), target: light.shadow_target(Vec3::splat(1.0 / 3.0)) }
+    fn of(world: &'w World, index: usize, light: &AreaLight) -> LightPoint<'w> {
+        LightPoint {
+            centroid: light.centroid(),
+            target: light.hard_shadow_target(),
+            normal: light.normal,
+            batch: world.hard_shadow_batch(index),
+        }
+    }
+
+    /// The direction of the segment from `origin` to the target read backwards, from the target,
+    /// if the batch holds its candidates: the origin lies in front of the target (a receiver the
+    /// light reaches almost always does; one just in front of the light's plane may not).
+    #[inline(always)]
+    fn reversed(&self, origin: Vec3) -> Option<Vec3> {
+        let dir = origin - self.target;
+        (self.batch.is_some() && self.normal.dot(dir) > 0.0).then_some(dir)
+    }
+
+    /// Whether something blocks `segment`, a segment towards the target: the batch's test of the
+    /// segment read backwards, or else the BVH's.
+    #[inline]
+    fn occluded(&self, world: &World, segment: &Ray) -> bool {
+        match (self.batch, self.reversed(segment.origin)) {
+            (Some(batch), Some(dir)) => world.occluded_in_batch(batch, &Ray { origin: self.target, dir, tmax: 1.0 }),
+            _ => world.occluded(segment),
+        }
+    }
+
+    /// [`LightPoint::occluded`] for the lanes `traced` of `segments`, bit `i` set if segment `i`
+    /// is blocked: those the batch takes tested together, ray-major (with the operations of the
+    /// batch's ray-by-ray test, so the same answers), the others as a packet.
+    #[inline]
+    fn occluded_lanes(&self, world: &World, segments: &[Ray; PACKET], traced: u32) -> u32 {
+        let mut dirs = [[0.0f32; PACKET]; 3];
+        let mut reversed = 0u32;
+        for lane in lanes_of(traced) {
+            if let Some(dir) = self.reversed(segments[lane].origin) {
+                set_row(&mut dirs, lane, dir);
+                reversed |= 1 << lane;
+            }
+        }
+        let mut blocked = 0;
+        if let (Some(batch), true) = (self.batch, reversed != 0) {
+            // The other lanes repeat a reversed one, so that the test can stop once all are blocked.
+            let first = reversed.trailing_zeros() as usize;
+            for lane in lanes_of(!reversed & const { all_lanes(PACKET) }) {
+                for row in &mut dirs {
+                    row[lane] = row[first];
+                }
+            }
+            blocked |= reversed
+                & world.simd(
+                    #[inline(always)]
+                    || world.occluded_lanes_in_batch(batch, &dirs, 1.0, reversed),
+                );
+        }
+        let rest = traced & !reversed;
+        if rest != 0 {
+            blocked |= rest & world.occluded_packet(segments, rest);
+        }
+        blocked
     }
 }
 

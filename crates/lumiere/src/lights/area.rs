@@ -34,6 +34,12 @@ impl AreaLight {
         b.x * p0 + b.y * p1 + b.z * p2
     }
 
+    /// Where the lab's hard shadows end their segments: the centroid of the shadow-target triangle.
+    #[inline]
+    pub fn hard_shadow_target(&self) -> Vec3 {
+        self.shadow_target(Vec3::splat(1.0 / 3.0))
+    }
+
     /// Radiance leaving the light towards direction `w` (pointing away from the light): its
     /// emission on the side its winding faces, nothing behind.
     #[inline]

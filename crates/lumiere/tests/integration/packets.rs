@@ -10,6 +10,8 @@ use lumiere::scene::camera::Camera;
 use lumiere::scene::{Scene, builtin};
 use lumiere::world::World;
 
+use crate::common::TestRng;
+
 /// Hard shadows light a packet's diffuse receivers together (SoA) and the others one at a time:
 /// on the built-in box with every other material made glossy, so that packets mix the two, each
 /// lane of each 4x4 block has the bits of `radiance` for its ray.
@@ -43,6 +45,50 @@ fn hard_shadow_packets_shade_mixed_materials_as_single_rays_do() {
         }
     }
     assert!(lit * 2 > compared, "{lit} of {compared} pixels lit");
+}
+
+/// Hard shadows test the segments towards a light's target read backwards, as rays from the
+/// target, against candidates gathered once from there (`World::hard_shadow_batch`). On the
+/// built-in box, on every ISA: segments from random points in front of each light (inside the
+/// boxes too) are blocked exactly where the BVH, tracing them forwards, says they are, one at a
+/// time and sixteen together; both answers are common. It fails if a blocker is left out of the
+/// candidates, or if a segment's end is misplaced by the reversal.
+#[test]
+fn hard_shadow_segments_read_backwards_are_blocked_where_the_bvh_says() {
+    for isa in Isa::supported() {
+        let world = World::with_isa(Scene::builtin().unwrap(), Default::default(), isa);
+        let bounds = world.scene().bounds();
+        let mut rng = TestRng(0x5EED_0000 + isa as u64);
+        for (index, light) in world.lights().lights().iter().enumerate() {
+            let batch = world.hard_shadow_batch(index).expect("the box's candidates are gathered");
+            let target = light.hard_shadow_target();
+            let (mut blocked, mut clear) = (0, 0);
+            let mut dirs = [[0.0f32; 16]; 3];
+            let mut forward = [false; 16];
+            let mut lane = 0;
+            while blocked + clear < 16_000 {
+                let p = bounds.min + (bounds.max - bounds.min) * rng.vec3(0.0, 1.0);
+                let dir = p - target;
+                if light.normal.dot(dir) <= 0.0 {
+                    continue;
+                }
+                forward[lane] = world.occluded(&Ray::segment(p, target));
+                let backward = world.occluded_in_batch(batch, &Ray { origin: target, dir, tmax: 1.0 });
+                assert_eq!(forward[lane], backward, "{isa}: light {index}, segment from {p} to {target}");
+                (dirs[0][lane], dirs[1][lane], dirs[2][lane]) = (dir.x, dir.y, dir.z);
+                (blocked, clear) = if backward { (blocked + 1, clear) } else { (blocked, clear + 1) };
+                lane += 1;
+                if lane == 16 {
+                    let together = world.simd(|| world.occluded_lanes_in_batch(batch, &dirs, 1.0, u32::from(u16::MAX)));
+                    for (lane, &forward) in forward.iter().enumerate() {
+                        assert_eq!(together & (1 << lane) != 0, forward, "{isa}: light {index}, lane {lane}");
+                    }
+                    lane = 0;
+                }
+            }
+            assert!(blocked > 1000 && clear > 1000, "{isa}: light {index}: {blocked} blocked, {clear} clear");
+        }
+    }
 }
 
 /// Path tracing follows a block's paths in lockstep (every path's next hit, then every vertex,
