@@ -1,6 +1,8 @@
 //! A scene with everything derived from it once before rendering: the acceleration structure and
 //! the lights. Integrators see the scene only through a [`World`].
 
+use std::sync::OnceLock;
+
 use glam::{Vec2, Vec3};
 
 use crate::accel::simd::lanes_of;
@@ -37,8 +39,9 @@ pub struct World {
     /// The diagonal of the scene's bounding box: no two of its points lie farther apart.
     diameter: f32,
     /// For each light, the triangles that may block a segment ending at its hard-shadow target
-    /// ([`World::hard_shadow_batch`]); empty where no light's would be gathered.
-    hard_shadow_batches: Vec<OriginBatch>,
+    /// ([`World::hard_shadow_batch`]), gathered when first asked for (only hard shadows ask);
+    /// empty where no light's would be gathered.
+    hard_shadow_batches: OnceLock<Vec<OriginBatch>>,
     /// Whether the records shading reads (the mesh's, the textures') outgrow a core's caches, so
     /// that asking for them ahead ([`World::prefetch_hit`], [`World::prefetch_bsdf`]) pays:
     /// where they all stay cached (the Cornell box), the requests only cost.
@@ -89,7 +92,6 @@ impl World {
         warnings.extend(cutout_warnings);
         let diameter = scene.bounds().extent().length();
         let prefetches = scene.mesh.memory_bytes() + textures.memory_bytes() > PREFETCH_ABOVE_BYTES;
-        let hard_shadow_batches = if cutouts.is_empty() { hard_shadow_batches(&accel, &lights) } else { Vec::new() };
         World {
             scene,
             accel,
@@ -101,7 +103,7 @@ impl World {
             cutouts,
             warnings,
             diameter,
-            hard_shadow_batches,
+            hard_shadow_batches: OnceLock::new(),
             prefetches,
         }
     }
@@ -113,7 +115,11 @@ impl World {
     /// candidates were not gathered (a large scene, cutouts: see [`OriginBatch::prepare`]).
     #[inline]
     pub fn hard_shadow_batch(&self, light: usize) -> Option<&OriginBatch> {
-        self.hard_shadow_batches.get(light).filter(|batch| !batch.traverses())
+        let batches = self.hard_shadow_batches.get_or_init(|| {
+            // A batch's triangles know nothing of cutouts.
+            if self.has_cutouts() { Vec::new() } else { hard_shadow_batches(&self.accel, &self.lights) }
+        });
+        batches.get(light).filter(|batch| !batch.traverses())
     }
 
     pub fn scene(&self) -> &Scene {
