@@ -109,10 +109,11 @@ impl World {
     }
 
     /// The candidate triangles of the segments that end at light `light`'s hard-shadow target
-    /// ([`crate::lights::AreaLight::hard_shadow_target`]), read backwards as rays leaving it into the half-space
-    /// in front of the light: every such segment of an image leaves from that one point, so the
-    /// batch is gathered once for the whole render, not once per receiver. `None` where the
-    /// candidates were not gathered (a large scene, cutouts: see [`OriginBatch::prepare`]).
+    /// ([`crate::lights::AreaLight::hard_shadow_target`]), read backwards as rays leaving it
+    /// into the half-space in front of the light: every such segment of an image leaves from that
+    /// one point, so the batch is gathered once for the whole render, not once per receiver.
+    /// `None` where the candidates were not gathered (a large scene, cutouts: see
+    /// [`OriginBatch::prepare`]).
     #[inline]
     pub fn hard_shadow_batch(&self, light: usize) -> Option<&OriginBatch> {
         let batches = self.hard_shadow_batches.get_or_init(|| {
