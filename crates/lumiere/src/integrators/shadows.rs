@@ -204,22 +204,25 @@ impl<'w> LightPoint<'w> {
     }
 
     /// The direction of the segment from `origin` to the target read backwards, from the target,
-    /// if the batch holds its candidates: the origin lies in front of the target (a receiver the
-    /// light reaches almost always does; one just in front of the light's plane may not).
+    /// if it leaves into the half-space the batch covers: the origin lies in front of the target
+    /// (a receiver the light reaches almost always does; one just in front of the light's plane
+    /// may not).
     #[inline(always)]
     fn reversed(&self, origin: Vec3) -> Option<Vec3> {
         let dir = origin - self.target;
-        (self.batch.is_some() && self.normal.dot(dir) > 0.0).then_some(dir)
+        (self.normal.dot(dir) > 0.0).then_some(dir)
     }
 
     /// Whether something blocks `segment`, a segment towards the target: the batch's test of the
     /// segment read backwards, or else the BVH's.
     #[inline]
     fn occluded(&self, world: &World, segment: &Ray) -> bool {
-        match (self.batch, self.reversed(segment.origin)) {
-            (Some(batch), Some(dir)) => world.occluded_in_batch(batch, &Ray { origin: self.target, dir, tmax: 1.0 }),
-            _ => world.occluded(segment),
+        if let Some(batch) = self.batch
+            && let Some(dir) = self.reversed(segment.origin)
+        {
+            return world.occluded_in_batch(batch, &Ray { origin: self.target, dir, tmax: 1.0 });
         }
+        world.occluded(segment)
     }
 
     /// [`LightPoint::occluded`] for the lanes `traced` of `segments`, bit `i` set if segment `i`
@@ -227,28 +230,30 @@ impl<'w> LightPoint<'w> {
     /// batch's ray-by-ray test, so the same answers), the others as a packet.
     #[inline]
     fn occluded_lanes(&self, world: &World, segments: &[Ray; PACKET], traced: u32) -> u32 {
-        let mut dirs = [[0.0f32; PACKET]; 3];
-        let mut reversed = 0u32;
-        for lane in lanes_of(traced) {
-            if let Some(dir) = self.reversed(segments[lane].origin) {
-                set_row(&mut dirs, lane, dir);
-                reversed |= 1 << lane;
-            }
-        }
-        let mut blocked = 0;
-        if let (Some(batch), true) = (self.batch, reversed != 0) {
-            // The other lanes repeat a reversed one, so that the test can stop once all are blocked.
-            let first = reversed.trailing_zeros() as usize;
-            for lane in lanes_of(!reversed & const { all_lanes(PACKET) }) {
-                for row in &mut dirs {
-                    row[lane] = row[first];
+        let (mut reversed, mut blocked) = (0u32, 0u32);
+        if let Some(batch) = self.batch {
+            let mut dirs = [[0.0f32; PACKET]; 3];
+            for lane in lanes_of(traced) {
+                if let Some(dir) = self.reversed(segments[lane].origin) {
+                    set_row(&mut dirs, lane, dir);
+                    reversed |= 1 << lane;
                 }
             }
-            blocked |= reversed
-                & world.simd(
-                    #[inline(always)]
-                    || world.occluded_lanes_in_batch(batch, &dirs, 1.0, reversed),
-                );
+            if reversed != 0 {
+                // The other lanes repeat a reversed one, so that the test can stop once all are
+                // blocked.
+                let first = reversed.trailing_zeros() as usize;
+                for lane in lanes_of(!reversed & const { all_lanes(PACKET) }) {
+                    for row in &mut dirs {
+                        row[lane] = row[first];
+                    }
+                }
+                blocked = reversed
+                    & world.simd(
+                        #[inline(always)]
+                        || world.occluded_lanes_in_batch(batch, &dirs, 1.0, reversed),
+                    );
+            }
         }
         let rest = traced & !reversed;
         if rest != 0 {
