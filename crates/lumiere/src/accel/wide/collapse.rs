@@ -56,6 +56,7 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
                 let leaf = leaf::encode::<W>(0, wide.blocks.len());
                 set_child(&mut wide.nodes[0], 0, leaf, root);
             }
+            wide.nodes[0].order_children();
         }
         wide
     }
@@ -77,6 +78,7 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
             };
             set_child(&mut self.nodes[wide_index], slot, reference, binary);
         }
+        self.nodes[wide_index].order_children();
         wide_index as u32
     }
 }

@@ -1,7 +1,8 @@
 //! Closest-hit and occlusion queries on the wide BVH: one `W`-lane box test per node, one `W`-lane
-//! watertight triangle test per leaf block (`triangles.rs`), iterative with a fixed stack, nearest
-//! child first; a tree of one node over a few blocks (the Cornell box) is tested block by block,
-//! without the walk. Generic over the lane kernel `L`; each entry point is monomorphised per kernel.
+//! watertight triangle test per leaf block (`triangles.rs`), iterative with a fixed stack, children
+//! in the node's near-to-far order for the ray's octant; a tree of one node over a few blocks (the
+//! Cornell box) is tested block by block, without the walk. Generic over the lane kernel `L`; each
+//! entry point is monomorphised per kernel.
 
 use std::mem::MaybeUninit;
 
@@ -16,12 +17,12 @@ use crate::accel::{Hit, TraversalStats, VisitOrder};
 use crate::math::Ray;
 
 /// The traversal stack, left uninitialised: zeroing it (2.3 KB per ray at `W = 4`) was measured to
-/// cost more than the whole traversal of a small scene. A wide level pushes at most `W - 1`
-/// siblings (`W` in the walks of `packet.rs` and `shared_origin.rs`, which pop the nearest right
-/// after), so
-/// `(W - 1) * MAX_DEPTH + 1` entries would do; stable Rust cannot size an array by an expression of
-/// a const parameter, so the stack holds one row of `W` entries per level. An entry is a node
-/// reference with its entry distance, or with the lanes that entered it (`shared_origin.rs`).
+/// cost more than the whole traversal of a small scene. A wide level pushes at most `W` children
+/// and pops the first to visit right after, so `(W - 1) * MAX_DEPTH + W` entries would do (writes
+/// included: [`Stack::push_if`] writes the entry it drops too); stable Rust cannot size an array by
+/// an expression of a const parameter, so the stack holds one row of `W` entries per level. An
+/// entry is a node reference with its entry distance, or with the lanes that entered it
+/// (`shared_origin.rs`).
 pub(super) struct Stack<const W: usize, T: Copy = (u32, f32)> {
     entries: [[MaybeUninit<T>; W]; MAX_DEPTH + 1],
     len: usize,
@@ -38,6 +39,15 @@ impl<const W: usize, T: Copy> Stack<W, T> {
         // The build bounds the depth by MAX_DEPTH and each level pushes at most W - 1 entries.
         self.entries.as_flattened_mut()[self.len] = MaybeUninit::new(entry);
         self.len += 1;
+    }
+
+    /// Pushes `entry` if `keep`, without a branch: the entry is written either way, and kept by
+    /// the length. Room for it: a level pushes at most `W` entries and pops one, so the length
+    /// stays below `(W - 1) * MAX_DEPTH + W`.
+    #[inline(always)]
+    pub(super) fn push_if(&mut self, entry: T, keep: bool) {
+        self.entries.as_flattened_mut()[self.len] = MaybeUninit::new(entry);
+        self.len += usize::from(keep);
     }
 
     #[inline(always)]
@@ -61,6 +71,8 @@ pub(super) fn near_row(d: f32, axis: usize) -> usize {
 pub(super) struct BoxRay<L> {
     /// Per axis, the bounds row that holds the entry (near) plane: min when the direction is positive.
     near_row: [usize; 3],
+    /// The direction's octant, bit `a` set where it is negative on axis `a` (as `near_row`).
+    octant: usize,
     origin: [L; 3],
     inv_dir: [L; 3],
 }
@@ -73,8 +85,10 @@ impl<L> BoxRay<L> {
     {
         let d = ray.dir.to_array();
         let o = ray.origin.to_array();
+        let near_row = [0, 1, 2].map(|a| near_row(d[a], a));
         BoxRay {
-            near_row: [0, 1, 2].map(|a| near_row(d[a], a)),
+            octant: (0..3).fold(0, |octant, a| octant | usize::from(near_row[a] > 2) << a),
+            near_row,
             origin: o.map(L::splat),
             inv_dir: d.map(|v| L::splat(safe_reciprocal(v))),
         }
@@ -200,7 +214,9 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
                     }
                     let node = &self.nodes[reference as usize];
                     let (mask, nears) = box_ray.enter(node, L::splat(tmax * PRUNE_SLACK));
-                    if let Some(next) = push_children(node, mask, &nears, &mut stack) {
+                    if let Some(next) =
+                        push_in_order(node, mask, &nears, box_ray.octant, VisitOrder::NearestFirst, &mut stack)
+                    {
                         current = next;
                         continue;
                     }
@@ -283,7 +299,7 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
                 }
                 let node = &self.nodes[reference as usize];
                 let (mask, nears) = box_ray.enter(node, tmax_lanes);
-                if let Some(next) = push_children(node, mask, &order.keys(nears), &mut stack) {
+                if let Some(next) = push_in_order(node, mask, &nears, box_ray.octant, order, &mut stack) {
                     current = next;
                     continue;
                 }
@@ -320,40 +336,33 @@ fn closest_in_block<const W: usize, L: Lanes<W>>(
     }
 }
 
-/// Pushes the entered children but the one of least key (entry distance, or a [`VisitOrder`]'s
-/// key for it), greatest key first, and returns the least to visit next.
+/// Pushes the entered children (`mask`) in the node's order for the ray's octant, the first to
+/// visit last (the nearest, or the farthest for [`VisitOrder::FarthestFirst`]), and returns that
+/// one (taken back off the stack): no sort of the entry distances, and no branch per child. On the
+/// staircase, its diffuse closest hits took 6-16% less time than with the children sorted by
+/// their entry distances, and its shadow rays 8% less (`lumiere bench-bvh`).
 #[inline(always)]
-fn push_children<const W: usize>(
+fn push_in_order<const W: usize>(
     node: &WideNode<W>,
     mask: u32,
     nears: &[f32; W],
+    octant: usize,
+    visit: VisitOrder,
     stack: &mut Stack<W>,
 ) -> Option<(u32, f32)> {
     if mask == 0 {
         return None;
     }
-    let first = mask.trailing_zeros() as usize;
     if mask & (mask - 1) == 0 {
+        let first = mask.trailing_zeros() as usize;
         return Some((node.children[first], nears[first]));
     }
-    // Two to W children: sort them by entry distance, nearest last (insertion sort on <= W items).
-    let mut entries = [(0u32, 0f32); W];
-    let mut count = 0;
-    let mut bits = mask;
-    while bits != 0 {
-        let lane = bits.trailing_zeros() as usize;
-        bits &= bits - 1;
-        let entry = (node.children[lane], nears[lane]);
-        let mut i = count;
-        while i > 0 && entries[i - 1].1 < entry.1 {
-            entries[i] = entries[i - 1];
-            i -= 1;
-        }
-        entries[i] = entry;
-        count += 1;
+    let order = node.near_to_far(octant);
+    for i in 0..W {
+        // The first visited is pushed last.
+        let k = if visit == VisitOrder::NearestFirst { W - 1 - i } else { i };
+        let slot = (order >> (4 * k)) as usize & 0xF;
+        stack.push_if((node.children[slot], nears[slot]), mask & (1 << slot) != 0);
     }
-    for &entry in &entries[..count - 1] {
-        stack.push(entry);
-    }
-    Some(entries[count - 1])
+    stack.pop()
 }
