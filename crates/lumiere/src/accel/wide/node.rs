@@ -47,8 +47,8 @@ impl<const W: usize> WideNode<W> {
     pub(super) fn near_to_far(&self, octant: usize) -> u32 {
         let octants_per_word = 8 / W;
         let bits = 4 * W as u32;
-        let word = self.near_to_far[octant / octants_per_word];
-        let order = word.checked_shr((octant % octants_per_word) as u32 * bits).unwrap_or(0);
+        // The shift is below 32: `(octants_per_word - 1) * bits = 32 - bits`.
+        let order = self.near_to_far[octant / octants_per_word] >> ((octant % octants_per_word) as u32 * bits);
         if bits == 32 { order } else { order & ((1 << bits) - 1) }
     }
 
