@@ -56,8 +56,10 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
                 let leaf = leaf::encode::<W>(0, wide.blocks.len());
                 set_child(&mut wide.nodes[0], 0, leaf, root);
             }
-            wide.nodes[0].order_children();
         }
+        // Once every child is set, in parallel: node by node inside the serial collapse, the
+        // orders made the bunny-1m build 8% longer at 2 threads.
+        wide.nodes.par_iter_mut().for_each(WideNode::order_children);
         wide
     }
 
@@ -78,7 +80,6 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
             };
             set_child(&mut self.nodes[wide_index], slot, reference, binary);
         }
-        self.nodes[wide_index].order_children();
         wide_index as u32
     }
 }

@@ -62,7 +62,7 @@ impl<const W: usize> WideNode<W> {
         let octants_per_word = 8 / W;
         self.near_to_far = [0; W];
         for octant in 0..8 {
-            let key = |slot: usize| {
+            let keys: [f32; W] = std::array::from_fn(|slot| {
                 if self.children[slot] == EMPTY_CHILD {
                     return f32::INFINITY;
                 }
@@ -72,9 +72,9 @@ impl<const W: usize> WideNode<W> {
                         if octant & (1 << axis) == 0 { centre } else { -centre }
                     })
                     .sum()
-            };
+            });
             let mut slots: [usize; W] = std::array::from_fn(|slot| slot);
-            slots.sort_by(|&a, &b| key(a).total_cmp(&key(b)));
+            slots.sort_by(|&a, &b| keys[a].total_cmp(&keys[b]));
             let order = slots.iter().enumerate().fold(0u32, |order, (k, &slot)| order | (slot as u32) << (4 * k));
             self.near_to_far[octant / octants_per_word] |= order << ((octant % octants_per_word) * 4 * W);
         }
