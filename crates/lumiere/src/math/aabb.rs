@@ -59,4 +59,9 @@ impl Aabb {
     pub fn contains(&self, inner: &Aabb) -> bool {
         inner.is_empty() || (self.min.cmple(inner.min).all() && inner.max.cmple(self.max).all())
     }
+
+    /// True if the two boxes share a point (inclusive), used by the BVH validator.
+    pub fn overlaps(&self, other: &Aabb) -> bool {
+        self.min.cmple(other.max).all() && other.min.cmple(self.max).all()
+    }
 }

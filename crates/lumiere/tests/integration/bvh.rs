@@ -218,6 +218,19 @@ fn random_meshes_match_brute_force_for_every_preset() {
     }
 }
 
+/// The default build on one thread and on three, after checking that they have the same nodes and
+/// that the first is valid.
+fn built_on_one_thread_and_three(positions: &[Vec3], indices: &[[u32; 3]]) -> (Bvh, Bvh) {
+    let build_on = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a thread pool");
+        pool.install(|| Bvh::build(positions, indices, BuildPreset::Default))
+    };
+    let (one, three) = (build_on(1), build_on(3));
+    assert_eq!(one.nodes(), three.nodes(), "the layout depends on the thread count");
+    assert_eq!(one.validate(), Ok(()));
+    (one, three)
+}
+
 /// Trees large enough to be built in parallel (subtrees of 4,096 triangles and more split on rayon,
 /// then written into one array) are the same node for node on one thread and on three, keep their
 /// structure valid, and answer like brute force; some of the triangles are degenerate, so the
@@ -237,13 +250,7 @@ fn large_trees_are_the_same_on_any_thread_count_and_match_brute_force() {
         positions.extend(corners);
         indices.push([3 * i, 3 * i + 1, 3 * i + 2]);
     }
-    let build_on = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a thread pool");
-        pool.install(|| Bvh::build(&positions, &indices, BuildPreset::Default))
-    };
-    let (one, three) = (build_on(1), build_on(3));
-    assert_eq!(one.nodes(), three.nodes(), "the layout depends on the thread count");
-    assert_eq!(one.validate(), Ok(()));
+    let (one, three) = built_on_one_thread_and_three(&positions, &indices);
     let rays: Vec<Ray> = (0..400)
         .map(|i| {
             let origin = rng.vec3(-15.0, 15.0);
@@ -259,6 +266,62 @@ fn large_trees_are_the_same_on_any_thread_count_and_match_brute_force() {
         assert_eq!(one.intersect(ray), three.intersect(ray), "{ray:?}");
     }
     check_against_brute_force(&positions, &indices, &rays, "20,000 triangles");
+}
+
+/// A room of large triangles (walls, floor, long slanted boards) filled with small ones, the
+/// staircase's shape: spatial splits cut the large triangles (more leaf slots than triangles, none
+/// for the fast preset, which makes none), the cut tree is valid, the same on one thread and on
+/// three, cheaper by the SAH, and answers like brute force, rays along the cuts included.
+#[test]
+fn spatial_splits_cut_large_triangles_and_answer_like_brute_force() {
+    let mut rng = TestRng(4242);
+    let mut positions: Vec<Vec3> = Vec::new();
+    let mut indices: Vec<[u32; 3]> = Vec::new();
+    let mut triangle = |corners: [Vec3; 3]| {
+        let base = positions.len() as u32;
+        positions.extend(corners);
+        indices.push([base, base + 1, base + 2]);
+    };
+    let c = 10.0;
+    for axis in 0..3 {
+        for side in [-c, c] {
+            let point = |u: f32, v: f32| {
+                let mut p = [0.0; 3];
+                (p[axis], p[(axis + 1) % 3], p[(axis + 2) % 3]) = (side, u, v);
+                Vec3::from_array(p)
+            };
+            triangle([point(-c, -c), point(c, -c), point(c, c)]);
+            triangle([point(-c, -c), point(c, c), point(-c, c)]);
+        }
+    }
+    for _ in 0..60 {
+        let (a, b) = (rng.vec3(-c, c), rng.vec3(-c, c));
+        triangle([a, b, a + rng.vec3(-0.5, 0.5)]);
+    }
+    for _ in 0..6_000 {
+        let centre = rng.vec3(-c, c);
+        triangle([0; 3].map(|_| centre + rng.vec3(-0.2, 0.2)));
+    }
+    let (one, three) = built_on_one_thread_and_three(&positions, &indices);
+    assert!(one.slot_count() > one.triangle_count(), "no triangle was cut");
+    let fast = Bvh::build(&positions, &indices, BuildPreset::Fast);
+    assert_eq!(fast.slot_count(), fast.triangle_count(), "the fast preset cut triangles");
+    assert!(one.sah_cost() < 0.9 * fast.sah_cost(), "SAH cost {} against {} uncut", one.sah_cost(), fast.sah_cost());
+    let rays: Vec<Ray> = (0..300)
+        .map(|i| {
+            let origin = rng.vec3(-0.9 * c, 0.9 * c);
+            match i % 3 {
+                0 => Ray::new(origin, positions[indices[rng.below(indices.len())][0] as usize] - origin),
+                // Parallel to a wall, close to it: along the planes that cut the walls.
+                1 => Ray::new(Vec3::new(origin.x, origin.y, c - 1e-3), Vec3::new(rng.range(-1.0, 1.0), 1.0, 0.0)),
+                _ => Ray::new(origin, rng.direction()),
+            }
+        })
+        .collect();
+    for ray in &rays {
+        assert_eq!(one.intersect(ray), three.intersect(ray), "{ray:?}");
+    }
+    check_against_brute_force(&positions, &indices, &rays, "a room of large and small triangles");
 }
 
 #[test]

@@ -2,6 +2,8 @@
 //!
 //! Each node bins triangle centroids along all three axes, sweeps the bins for the split of least
 //! surface-area cost, and becomes a leaf when no split beats intersecting its triangles directly.
+//! Where that split's children overlap much, the node also tries cutting its triangles by a plane
+//! (`spatial_split.rs`), and takes whichever costs less.
 //! Large subtrees are built in parallel with rayon, then written once into one array, so siblings
 //! stay adjacent and the layout is the same whatever the thread count.
 //!
@@ -15,6 +17,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use glam::{Vec3, Vec3A};
 use rayon::prelude::*;
 
+use super::spatial_split::{self, SpatialSplit};
 use super::{Bvh, Node};
 use crate::geometry::triangle::is_degenerate;
 use crate::math::Aabb;
@@ -32,12 +35,12 @@ const PARALLEL_THRESHOLD: usize = 4096;
 /// Named trade-offs between build time and trace speed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum BuildPreset {
-    /// 8 bins: the quickest build, a slightly worse tree.
+    /// 8 bins and no spatial splits: the quickest build, a slightly worse tree.
     Fast,
-    /// 16 bins.
+    /// 16 bins, spatial splits.
     #[default]
     Default,
-    /// 64 bins.
+    /// 64 bins, spatial splits.
     HighQuality,
 }
 
@@ -49,6 +52,15 @@ impl BuildPreset {
             BuildPreset::Fast => 8,
             BuildPreset::Default => 16,
             BuildPreset::HighQuality => 64,
+        }
+    }
+
+    /// Extra references spatial splits may add, as a share of the triangles: none for the
+    /// quickest build.
+    fn reference_budget(self) -> f64 {
+        match self {
+            BuildPreset::Fast => 0.0,
+            BuildPreset::Default | BuildPreset::HighQuality => spatial_split::REFERENCE_BUDGET,
         }
     }
 
@@ -75,31 +87,45 @@ pub(super) fn leaf_cost(count: usize, block_width: usize) -> f64 {
 
 /// Nodes with more triangles than this bin them in parallel chunks (the top levels, where
 /// `rayon::join` has not yet split the work).
-const PARALLEL_BINNING_THRESHOLD: usize = 1 << 16;
-const BINNING_CHUNK: usize = 1 << 14;
+pub(super) const PARALLEL_BINNING_THRESHOLD: usize = 1 << 16;
+pub(super) const BINNING_CHUNK: usize = 1 << 14;
 
 /// A box in 16-byte lanes, so that growing it is one SSE min and one max.
 #[derive(Clone, Copy, Debug)]
-struct Box3A {
-    min: Vec3A,
-    max: Vec3A,
+pub(super) struct Box3A {
+    pub(super) min: Vec3A,
+    pub(super) max: Vec3A,
 }
 
 impl Box3A {
-    const EMPTY: Box3A = Box3A { min: Vec3A::INFINITY, max: Vec3A::NEG_INFINITY };
+    pub(super) const EMPTY: Box3A = Box3A { min: Vec3A::INFINITY, max: Vec3A::NEG_INFINITY };
 
     #[inline(always)]
-    fn union(self, o: Box3A) -> Box3A {
+    pub(super) fn union(self, o: Box3A) -> Box3A {
         Box3A { min: self.min.min(o.min), max: self.max.max(o.max) }
     }
 
     #[inline(always)]
-    fn grow(self, p: Vec3A) -> Box3A {
+    pub(super) fn grow(self, p: Vec3A) -> Box3A {
         Box3A { min: self.min.min(p), max: self.max.max(p) }
     }
 
     fn to_aabb(self) -> Aabb {
         Aabb { min: self.min.into(), max: self.max.into() }
+    }
+
+    /// `Aabb::half_area`'s arithmetic (f32 extent, f64 products, so that huge coordinates cannot
+    /// overflow) without its conversions.
+    #[inline(always)]
+    fn half_area(self) -> f64 {
+        let e = (self.max - self.min).as_dvec3();
+        e.x * e.y + e.y * e.z + e.z * e.x
+    }
+
+    /// The box both boxes hold, or None.
+    pub(super) fn intersection(self, o: Box3A) -> Option<Box3A> {
+        let b = Box3A { min: self.min.max(o.min), max: self.max.min(o.max) };
+        (!b.min.cmpgt(b.max).any()).then_some(b)
     }
 
     #[inline(always)]
@@ -112,24 +138,31 @@ impl Box3A {
 const DEGENERATE: u32 = u32::MAX;
 
 /// A triangle as the build moves it: its box and its id, 32 bytes.
+/// With spatial splits (`spatial_split.rs`) a reference may hold the box of a piece of its
+/// triangle, and a triangle may have several references.
 #[derive(Clone, Copy)]
 #[repr(C, align(16))]
-struct PrimRef {
+pub(super) struct PrimRef {
     min: [f32; 3],
-    id: u32,
+    pub(super) id: u32,
     max: [f32; 3],
 }
 
 impl PrimRef {
     #[inline(always)]
-    fn bounds(&self) -> Box3A {
+    pub(super) fn bounds(&self) -> Box3A {
         Box3A { min: Vec3A::from_array(self.min), max: Vec3A::from_array(self.max) }
+    }
+
+    /// This reference for a piece of its triangle boxed by `bounds`.
+    pub(super) fn with_bounds(self, bounds: Box3A) -> PrimRef {
+        PrimRef { min: bounds.min.to_array(), max: bounds.max.to_array(), ..self }
     }
 }
 
 /// Bounds of the triangles of a node and of their centroids, gathered in one pass.
 #[derive(Clone, Copy)]
-struct NodeBounds {
+pub(super) struct NodeBounds {
     bounds: Box3A,
     centroids: Box3A,
 }
@@ -147,7 +180,7 @@ impl NodeBounds {
     }
 
     /// The bounds of `refs`, in parallel chunks when there are many.
-    fn of(refs: &[PrimRef]) -> NodeBounds {
+    pub(super) fn of(refs: &[PrimRef]) -> NodeBounds {
         let gather = |refs: &[PrimRef]| refs.iter().fold(NodeBounds::EMPTY, |acc, r| acc.grow(r.bounds()));
         if refs.len() > PARALLEL_BINNING_THRESHOLD {
             refs.par_chunks(BINNING_CHUNK).map(gather).reduce(|| NodeBounds::EMPTY, NodeBounds::merge)
@@ -159,8 +192,28 @@ impl NodeBounds {
 
 /// What every node of one build shares. `W` is the block width the SAH counts leaves in: a const,
 /// not a field, so that `leaf_cost` divides by a constant in the split sweep.
-struct Context<const W: usize> {
+pub(super) struct Context<'a, const W: usize> {
     bins: usize,
+    positions: &'a [Vec3],
+    indices: &'a [[u32; 3]],
+    /// Spatial splits are tried where the object split's children overlap by more than this.
+    spatial_overlap: f64,
+}
+
+impl<const W: usize> Context<'_, W> {
+    pub(super) fn corners(&self, id: u32) -> [Vec3; 3] {
+        self.indices[id as usize].map(|i| self.positions[i as usize])
+    }
+
+    /// Whether a node of box `node` whose best object split along `axis` leaves its children
+    /// sharing the box `overlap` should try a spatial split (`spatial_split.rs`): where the overlap
+    /// is large by area and thick along the axis. A fine mesh's object splits overlap in a thin
+    /// slab of small straddling triangles, which cutting cannot much improve.
+    fn worth_a_spatial_split(&self, overlap: Box3A, node: Box3A, axis: usize) -> bool {
+        overlap.half_area() > self.spatial_overlap
+            && overlap.max[axis] - overlap.min[axis]
+                > spatial_split::OVERLAP_THICKNESS * (node.max[axis] - node.min[axis])
+    }
 }
 
 /// Builds the tree; with `copy_vertices` false the leaf-order corner copy is left out (for a tree
@@ -196,152 +249,212 @@ pub fn build<const W: usize>(
     if degenerate.into_inner() {
         refs.retain(|r| r.id != DEGENERATE);
     }
-    let ctx = Context::<W> { bins: preset.bins() };
+    let triangles = refs.len();
 
-    let nodes = if refs.is_empty() {
-        vec![Node::new(Aabb::EMPTY, 0, 0)]
+    let (nodes, triangle_ids) = if refs.is_empty() {
+        (vec![Node::new(Aabb::EMPTY, 0, 0)], Vec::new())
     } else {
         let bounds = NodeBounds::of(&refs);
-        build_subtree(&ctx, &mut refs, bounds, 0, 0).into_nodes()
+        let ctx = Context::<W> {
+            bins: preset.bins(),
+            positions,
+            indices,
+            spatial_overlap: spatial_split::OVERLAP_SHARE * bounds.bounds.half_area(),
+        };
+        let spare = (triangles as f64 * preset.reference_budget()) as usize;
+        build_subtree(&ctx, &mut refs, bounds, spare, 0).into_tree()
     };
-    let triangle_ids: Vec<u32> = refs.par_iter().map(|r| r.id).collect();
     let vertices = if copy_vertices {
         triangle_ids.par_iter().map(|&id| corners(&indices[id as usize])).collect()
     } else {
         Vec::new()
     };
-    Bvh { nodes, vertices, triangle_ids, input_triangles: indices.len(), block_width: W }
+    Bvh { nodes, vertices, triangle_ids, triangles, input_triangles: indices.len(), block_width: W }
 }
 
-/// A subtree as the parallel build returns it: built on one thread into an array of its own
-/// (root at 0), or a node whose two subtrees were built in parallel. [`Subtree::place`] then
-/// writes every node once into the tree's array; stitching the arrays together level by level
-/// copied each node once per parallel level (eight on the 1.1M-triangle bunny), into fresh pages.
+/// A subtree as the parallel build returns it: built on one thread into arrays of its own (root
+/// at 0, leaves numbering their triangle slots from 0), or a node whose two subtrees were built
+/// in parallel. [`Subtree::place`] then writes every node and slot once into the tree's arrays;
+/// stitching the arrays together level by level copied each node once per parallel level (eight
+/// on the 1.1M-triangle bunny), into fresh pages.
 enum Subtree {
-    Local(Vec<Node>),
-    Split { bounds: Aabb, left: Box<Subtree>, right: Box<Subtree>, size: usize },
+    Local(LocalTree),
+    Split { bounds: Aabb, left: Box<Subtree>, right: Box<Subtree>, size: usize, slots: usize },
 }
 
 impl Subtree {
     /// Nodes in the subtree, its root included.
     fn size(&self) -> usize {
         match self {
-            Subtree::Local(nodes) => nodes.len(),
+            Subtree::Local(tree) => tree.nodes.len(),
             Subtree::Split { size, .. } => *size,
         }
     }
 
-    /// Writes the root into `root` and the other nodes into `rest`, which starts at index
-    /// `rest_start` of the tree's array. The layout is the one [`build_into`] gives a subtree
-    /// built on one thread: a node's two children side by side, the left one's descendants next,
-    /// then the right one's.
-    fn place(self, root: &mut Node, rest: &mut [Node], rest_start: usize) {
-        debug_assert_eq!(rest.len() + 1, self.size());
+    /// Triangle slots of its leaves (references: a triangle split by a spatial split has several).
+    fn slots(&self) -> usize {
         match self {
-            Subtree::Local(nodes) => {
+            Subtree::Local(tree) => tree.triangle_ids.len(),
+            Subtree::Split { slots, .. } => *slots,
+        }
+    }
+
+    /// Writes the root into `root` and the other nodes into `rest`, which starts at index
+    /// `rest_start` of the tree's array, and the leaves' triangle ids into `ids`, which starts at
+    /// slot `slot_start`. The layout is the one [`build_into`] gives a subtree built on one
+    /// thread: a node's two children side by side, the left one's descendants next, then the
+    /// right one's; the left one's slots before the right one's.
+    fn place(self, root: &mut Node, rest: &mut [Node], rest_start: usize, ids: &mut [u32], slot_start: usize) {
+        debug_assert_eq!((rest.len() + 1, ids.len()), (self.size(), self.slots()));
+        match self {
+            Subtree::Local(LocalTree { nodes, triangle_ids }) => {
                 // Local index j > 0 moves to `rest_start + j - 1`; local 0 is `root`.
                 let relink = |node: Node| {
-                    if node.is_leaf() {
-                        return node;
-                    }
-                    Node { first: (rest_start + node.first as usize - 1) as u32, ..node }
+                    let first = if node.is_leaf() {
+                        slot_start + node.first as usize
+                    } else {
+                        rest_start + node.first as usize - 1
+                    };
+                    Node { first: first as u32, ..node }
                 };
                 *root = relink(nodes[0]);
                 for (slot, &node) in rest.iter_mut().zip(&nodes[1..]) {
                     *slot = relink(node);
                 }
+                ids.copy_from_slice(&triangle_ids);
             }
             Subtree::Split { bounds, left, right, .. } => {
                 *root = Node::new(bounds, rest_start as u32, 0);
                 let (roots, descendants) = rest.split_at_mut(2);
                 let (left_root, right_root) = roots.split_at_mut(1);
-                let left_size = left.size();
+                let (left_size, left_slots) = (left.size(), left.slots());
                 let (left_rest, right_rest) = descendants.split_at_mut(left_size - 1);
                 let (left_start, right_start) = (rest_start + 2, rest_start + 1 + left_size);
+                let (left_ids, right_ids) = ids.split_at_mut(left_slots);
                 rayon::join(
-                    || left.place(&mut left_root[0], left_rest, left_start),
-                    || right.place(&mut right_root[0], right_rest, right_start),
+                    || left.place(&mut left_root[0], left_rest, left_start, left_ids, slot_start),
+                    || right.place(&mut right_root[0], right_rest, right_start, right_ids, slot_start + left_slots),
                 );
             }
         }
     }
 
-    /// The tree's node array, root at 0.
-    fn into_nodes(self) -> Vec<Node> {
+    /// The tree's node array, root at 0, and its triangle ids in slot order.
+    fn into_tree(self) -> (Vec<Node>, Vec<u32>) {
         let mut nodes = vec![Node::default(); self.size()];
+        let mut ids = vec![0; self.slots()];
         let (root, rest) = nodes.split_at_mut(1);
-        self.place(&mut root[0], rest, 1);
-        nodes
+        self.place(&mut root[0], rest, 1, &mut ids, 0);
+        (nodes, ids)
     }
 }
 
-/// Builds the subtree over `refs` (whose bounds are `bounds`, and whose first element is triangle
-/// slot `offset` in leaf order): large ones split in parallel, the rest on this thread.
+/// How a node's references are divided between its children.
+enum Partition {
+    /// The first `mid` references, moved in place, go left.
+    Object { mid: usize, left: NodeBounds, right: NodeBounds },
+    /// Spatial splits copy straddling references, so the children get arrays of their own.
+    Spatial { left_refs: Vec<PrimRef>, left: NodeBounds, right_refs: Vec<PrimRef>, right: NodeBounds },
+}
+
+impl Partition {
+    /// The children's references, bounds and shares of `spare`, the extra references the node
+    /// may still add: what a spatial split added is taken out, the rest divided by size.
+    fn children<'r>(
+        &'r mut self,
+        refs: &'r mut [PrimRef],
+        spare: usize,
+    ) -> [(&'r mut [PrimRef], NodeBounds, usize); 2] {
+        let parent = refs.len();
+        let (left_refs, left, right_refs, right) = match self {
+            Partition::Object { mid, left, right } => {
+                let (l, r) = refs.split_at_mut(*mid);
+                (l, *left, r, *right)
+            }
+            Partition::Spatial { left_refs, left, right_refs, right } => {
+                (&mut left_refs[..], *left, &mut right_refs[..], *right)
+            }
+        };
+        let total = left_refs.len() + right_refs.len();
+        let spare = spare.saturating_sub(total - parent);
+        let left_spare = (spare as u128 * left_refs.len() as u128 / total as u128) as usize;
+        [(left_refs, left, left_spare), (right_refs, right, spare - left_spare)]
+    }
+}
+
+/// Builds the subtree over `refs` (whose bounds are `bounds`, and which may add `spare` references
+/// by spatial splits): large ones split in parallel, the rest on this thread.
 fn build_subtree<const W: usize>(
     ctx: &Context<W>,
     refs: &mut [PrimRef],
     bounds: NodeBounds,
-    offset: usize,
+    spare: usize,
     depth: usize,
 ) -> Subtree {
     if refs.len() >= PARALLEL_THRESHOLD
-        && let Some((mid, left_bounds, right_bounds)) =
-            choose_split(ctx, refs, &bounds.bounds.to_aabb(), &bounds.centroids.to_aabb(), depth)
+        && let Some(mut partition) = choose_split(ctx, refs, &bounds, spare, depth)
     {
-        let (left, right) = refs.split_at_mut(mid);
+        let node_bounds = bounds.bounds.to_aabb();
+        let [(left, left_bounds, left_spare), (right, right_bounds, right_spare)] = partition.children(refs, spare);
         let (left, right) = rayon::join(
-            || build_subtree(ctx, left, left_bounds, offset, depth + 1),
-            || build_subtree(ctx, right, right_bounds, offset + mid, depth + 1),
+            || build_subtree(ctx, left, left_bounds, left_spare, depth + 1),
+            || build_subtree(ctx, right, right_bounds, right_spare, depth + 1),
         );
-        let size = 1 + left.size() + right.size();
-        return Subtree::Split { bounds: bounds.bounds.to_aabb(), left: Box::new(left), right: Box::new(right), size };
+        let (size, slots) = (1 + left.size() + right.size(), left.slots() + right.slots());
+        return Subtree::Split { bounds: node_bounds, left: Box::new(left), right: Box::new(right), size, slots };
     }
-    let mut nodes = Vec::with_capacity(refs.len());
-    nodes.push(Node::default());
-    build_into(ctx, refs, bounds, offset, depth, 0, &mut nodes);
-    Subtree::Local(nodes)
+    let mut tree = LocalTree { nodes: Vec::with_capacity(refs.len()), triangle_ids: Vec::with_capacity(refs.len()) };
+    tree.nodes.push(Node::default());
+    build_into(ctx, refs, bounds, spare, depth, 0, &mut tree);
+    Subtree::Local(tree)
 }
 
-/// Fills node `index` of `nodes` for the triangles `refs`, appending its descendants (on this
-/// thread).
+/// A subtree built on one thread: its nodes, root at 0, and its leaves' triangle ids, whose
+/// positions are the slots its leaves number from 0.
+struct LocalTree {
+    nodes: Vec<Node>,
+    triangle_ids: Vec<u32>,
+}
+
+/// Fills node `index` of `tree` for the triangles `refs`, appending its descendants (on this
+/// thread) and its leaves' triangle ids.
 fn build_into<const W: usize>(
     ctx: &Context<W>,
     refs: &mut [PrimRef],
     node_bounds: NodeBounds,
-    offset: usize,
+    spare: usize,
     depth: usize,
     index: usize,
-    nodes: &mut Vec<Node>,
+    tree: &mut LocalTree,
 ) {
     let bounds = node_bounds.bounds.to_aabb();
-    let Some((mid, left_bounds, right_bounds)) =
-        choose_split(ctx, refs, &bounds, &node_bounds.centroids.to_aabb(), depth)
-    else {
-        nodes[index] = Node::new(bounds, offset as u32, refs.len() as u32);
+    let Some(mut partition) = choose_split(ctx, refs, &node_bounds, spare, depth) else {
+        tree.nodes[index] = Node::new(bounds, tree.triangle_ids.len() as u32, refs.len() as u32);
+        tree.triangle_ids.extend(refs.iter().map(|r| r.id));
         return;
     };
-    let (left, right) = refs.split_at_mut(mid);
-    let first_child = nodes.len();
-    nodes[index] = Node::new(bounds, first_child as u32, 0);
-    nodes.push(Node::default());
-    nodes.push(Node::default());
-    build_into(ctx, left, left_bounds, offset, depth + 1, first_child, nodes);
-    build_into(ctx, right, right_bounds, offset + mid, depth + 1, first_child + 1, nodes);
+    let first_child = tree.nodes.len();
+    tree.nodes[index] = Node::new(bounds, first_child as u32, 0);
+    tree.nodes.push(Node::default());
+    tree.nodes.push(Node::default());
+    for (child, (refs, bounds, spare)) in partition.children(refs, spare).into_iter().enumerate() {
+        build_into(ctx, refs, bounds, spare, depth + 1, first_child + child, tree);
+    }
 }
 
-/// Decides whether to split `refs`; if so, partitions it in place and returns the size of the left
-/// part and the bounds of both parts.
+/// Decides whether to split `refs`, and how.
 fn choose_split<const W: usize>(
     ctx: &Context<W>,
     refs: &mut [PrimRef],
-    bounds: &Aabb,
-    centroid_bounds: &Aabb,
+    node: &NodeBounds,
+    spare: usize,
     depth: usize,
-) -> Option<(usize, NodeBounds, NodeBounds)> {
+) -> Option<Partition> {
     let count = refs.len();
     if count <= 1 {
         return None;
     }
+    let (bounds, centroid_bounds) = (node.bounds.to_aabb(), node.centroids.to_aabb());
     let extent = centroid_bounds.extent();
     let binnable = extent.max_element() > 0.0 && extent.is_finite();
     if depth >= SAH_DEPTH_LIMIT || !binnable {
@@ -350,24 +463,43 @@ fn choose_split<const W: usize>(
         return median_split(refs, if binnable { extent.max_position() } else { 0 });
     }
 
-    let Some(split) = best_binned_split(ctx, refs, centroid_bounds) else {
+    let Some(split) = best_binned_split(ctx, refs, &centroid_bounds) else {
         return median_split(refs, extent.max_position());
     };
+    // Where the object split's children overlap much, cutting the triangles may do better.
+    let spatial = (spare > 0 && split.overlap.is_some_and(|o| ctx.worth_a_spatial_split(o, node.bounds, split.axis)))
+        .then(|| best_spatial_split(ctx, refs, node.bounds))
+        .flatten()
+        .filter(|s| s.cost < split.cost && s.extra_references <= spare);
+    let best_cost = spatial.as_ref().map_or(split.cost, |s| s.cost);
     let as_leaf = INTERSECTION_COST * leaf_cost(count, W);
-    let split_cost = TRAVERSAL_COST + INTERSECTION_COST * split.cost / bounds.half_area();
+    let split_cost = TRAVERSAL_COST + INTERSECTION_COST * best_cost / bounds.half_area();
     if count <= MAX_LEAF_SIZE && as_leaf <= split_cost {
         return None;
+    }
+    if let Some((left_refs, left, right_refs, right)) = spatial.and_then(|s| spatial_split::partition(ctx, refs, &s)) {
+        return Some(Partition::Spatial { left_refs, left, right_refs, right });
     }
     let (axis, min, scale) = (split.axis, centroid_bounds.min[split.axis], split.scale);
     // A centroid is in a bin below `split.bin` exactly when its position in bins, `x >= 0`, is
     // below it: `floor(x) < k` iff `x < k` for a whole `k` (the clamp to the last bin cannot
     // matter, `k` being at most that bin). Compared as floats: the conversion costs more.
     let boundary = split.bin as f32;
-    Some(partition(refs, |b| (b.centroid()[axis] - min) * scale < boundary))
+    let (mid, left, right) = partition(refs, |b| (b.centroid()[axis] - min) * scale < boundary);
+    Some(Partition::Object { mid, left, right })
+}
+
+/// The spatial split of `refs` over the preset's bins.
+fn best_spatial_split<const W: usize>(ctx: &Context<W>, refs: &[PrimRef], bounds: Box3A) -> Option<SpatialSplit> {
+    match ctx.bins {
+        8 => spatial_split::best_spatial_split::<W, 8>(ctx, refs, bounds),
+        16 => spatial_split::best_spatial_split::<W, 16>(ctx, refs, bounds),
+        _ => spatial_split::best_spatial_split::<W, 64>(ctx, refs, bounds),
+    }
 }
 
 /// Halves `refs` by centroid along `axis`, or makes a leaf if it is small enough.
-fn median_split(refs: &mut [PrimRef], axis: usize) -> Option<(usize, NodeBounds, NodeBounds)> {
+fn median_split(refs: &mut [PrimRef], axis: usize) -> Option<Partition> {
     if refs.len() <= MAX_LEAF_SIZE {
         return None;
     }
@@ -375,7 +507,7 @@ fn median_split(refs: &mut [PrimRef], axis: usize) -> Option<(usize, NodeBounds,
     let key = |r: &PrimRef| r.bounds().centroid()[axis];
     refs.select_nth_unstable_by(mid, |a, b| key(a).total_cmp(&key(b)));
     let (left, right) = refs.split_at(mid);
-    Some((mid, NodeBounds::of(left), NodeBounds::of(right)))
+    Some(Partition::Object { mid, left: NodeBounds::of(left), right: NodeBounds::of(right) })
 }
 
 struct Split {
@@ -385,12 +517,14 @@ struct Split {
     /// `area_left * leaf_cost(count_left) + area_right * leaf_cost(count_right)` (half areas).
     cost: f64,
     scale: f32,
+    /// The box the two sides' boxes share, if any (spatial splits are tried where it is large).
+    overlap: Option<Box3A>,
 }
 
 #[derive(Clone, Copy)]
-struct Bin {
-    bounds: Box3A,
-    count: u32,
+pub(super) struct Bin {
+    pub(super) bounds: Box3A,
+    pub(super) count: u32,
 }
 
 impl Bin {
@@ -404,12 +538,11 @@ impl Bin {
     /// that huge coordinates cannot overflow) without its conversions: the sweep runs it 90
     /// times a node at 16 bins.
     #[inline(always)]
-    fn cost<const W: usize>(self) -> f64 {
+    pub(super) fn cost<const W: usize>(self) -> f64 {
         if self.count == 0 {
             return 0.0;
         }
-        let e = (self.bounds.max - self.bounds.min).as_dvec3();
-        (e.x * e.y + e.y * e.z + e.z * e.x) * leaf_cost(self.count as usize, W)
+        self.bounds.half_area() * leaf_cost(self.count as usize, W)
     }
 }
 
@@ -492,12 +625,12 @@ fn best_binned_split_with<const W: usize, const B: usize>(refs: &[PrimRef], cent
             continue;
         }
         let row = &grid[axis];
-        // right_cost[k] = area * cost of bins k.. (suffix), filled right to left.
-        let mut right_cost = [0.0f64; B];
+        // right[k] = bins k.. (suffix) and their area * cost, filled right to left.
+        let mut right = [(Bin::EMPTY, 0.0f64); B];
         let mut acc = Bin::EMPTY;
         for k in (1..bins).rev() {
             acc = acc.merge(row[k]);
-            right_cost[k] = acc.cost::<W>();
+            right[k] = (acc, acc.cost::<W>());
         }
         let mut left = Bin::EMPTY;
         for k in 1..bins {
@@ -505,9 +638,10 @@ fn best_binned_split_with<const W: usize, const B: usize>(refs: &[PrimRef], cent
             if left.count == 0 || left.count as usize == refs.len() {
                 continue;
             }
-            let cost = left.cost::<W>() + right_cost[k];
+            let cost = left.cost::<W>() + right[k].1;
             if best.as_ref().is_none_or(|b| cost < b.cost) {
-                best = Some(Split { axis, bin: k, cost, scale: scale[axis] });
+                let overlap = left.bounds.intersection(right[k].0.bounds);
+                best = Some(Split { axis, bin: k, cost, scale: scale[axis], overlap });
             }
         }
     }

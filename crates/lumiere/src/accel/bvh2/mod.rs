@@ -1,9 +1,10 @@
-//! The binary BVH: the binned-SAH build every layout starts from, flat 32-byte nodes, a scalar
+//! The binary BVH: the binned-SAH build (with spatial splits) every layout starts from, flat 32-byte nodes, a scalar
 //! closest-hit and occlusion traversal (the reference the wide kernels must match bit for bit), and
 //! the structural validator.
 
 mod build;
 mod node;
+mod spatial_split;
 mod traverse;
 mod validate;
 
@@ -22,8 +23,11 @@ pub struct Bvh {
     nodes: Vec<Node>,
     /// `vertices[i]` are the corners of the `i`-th triangle in leaf order.
     pub(super) vertices: Vec<[Vec3; 3]>,
-    /// `triangle_ids[i]` is the scene's id of the `i`-th triangle in leaf order.
+    /// `triangle_ids[i]` is the scene's id of the triangle in leaf-order slot `i`. A triangle cut
+    /// by spatial splits fills a slot in each leaf that holds a piece of it.
     pub(super) triangle_ids: Vec<u32>,
+    /// Distinct triangles in the tree.
+    triangles: usize,
     /// Triangles given to the build, degenerate ones included.
     input_triangles: usize,
     /// Triangles per block of the wide layout the SAH was computed for (see `build::leaf_cost`).
@@ -68,6 +72,11 @@ impl Bvh {
 
     /// Triangles in the tree (the input less its zero-area triangles).
     pub fn triangle_count(&self) -> usize {
+        self.triangles
+    }
+
+    /// Leaf slots: the triangles, plus the extra references spatial splits added.
+    pub fn slot_count(&self) -> usize {
         self.triangle_ids.len()
     }
 

@@ -3,13 +3,31 @@
 use super::Bvh;
 use crate::geometry::triangle::is_degenerate;
 
-/// Every non-degenerate input triangle reachable exactly once, children inside their parent, leaves
-/// within size limits, leaf-ordered vertices matching the ids, no cycles.
+/// Every slot reachable exactly once, every triangle in at least one slot, children inside their
+/// parent, leaves within size limits and bounding their triangles (a triangle in several leaves, cut
+/// by spatial splits: each of its corners in one of them), no cycles.
 pub fn validate(bvh: &Bvh) -> Result<(), String> {
     let n = bvh.triangle_ids.len();
-    if bvh.vertices.len() != n || n > bvh.input_triangles {
-        return Err(format!("{n} ids / {} vertices for {} input triangles", bvh.vertices.len(), bvh.input_triangles));
+    if bvh.vertices.len() != n || bvh.triangles > bvh.input_triangles || bvh.triangles > n {
+        return Err(format!(
+            "{n} slots / {} vertices for {} triangles of {} input triangles",
+            bvh.vertices.len(),
+            bvh.triangles,
+            bvh.input_triangles
+        ));
     }
+    let mut slots_of_triangle = vec![0u32; bvh.input_triangles];
+    for &id in &bvh.triangle_ids {
+        match slots_of_triangle.get_mut(id as usize) {
+            Some(slots) => *slots += 1,
+            None => return Err(format!("triangle id {id} exceeds the input")),
+        }
+    }
+    if slots_of_triangle.iter().filter(|&&s| s > 0).count() != bvh.triangles {
+        return Err(format!("the slots hold other than {} distinct triangles", bvh.triangles));
+    }
+    // Corners of the triangles in several leaves found inside one of them.
+    let mut corners_bounded = vec![[false; 3]; bvh.input_triangles];
     if let Some(slot) = (0..n).find(|&i| {
         let [p0, p1, p2] = bvh.vertices[i];
         is_degenerate(p0, p1, p2)
@@ -43,8 +61,15 @@ pub fn validate(bvh: &Bvh) -> Result<(), String> {
                     return Err(format!("triangle slot {slot} in two leaves"));
                 }
                 let tri = crate::math::Aabb::from_points(&bvh.vertices[slot]);
-                if !node.bounds().contains(&tri) {
+                let id = bvh.triangle_ids[slot] as usize;
+                if slots_of_triangle[id] == 1 && !node.bounds().contains(&tri) {
                     return Err(format!("leaf {index} does not bound triangle slot {slot}"));
+                }
+                if !node.bounds().overlaps(&tri) {
+                    return Err(format!("leaf {index} holds triangle slot {slot} outside its box"));
+                }
+                for (bounded, &corner) in corners_bounded[id].iter_mut().zip(&bvh.vertices[slot]) {
+                    *bounded |= node.bounds().contains(&crate::math::Aabb::from_points(&[corner]));
                 }
             }
         } else {
@@ -63,10 +88,9 @@ pub fn validate(bvh: &Bvh) -> Result<(), String> {
     if let Some(slot) = seen_triangle.iter().position(|s| !s) {
         return Err(format!("triangle slot {slot} unreachable"));
     }
-    let mut ids = bvh.triangle_ids.clone();
-    ids.sort_unstable();
-    if ids.windows(2).any(|w| w[0] == w[1]) || ids.last().is_some_and(|&id| id as usize >= bvh.input_triangles) {
-        return Err("triangle ids repeat or exceed the input".into());
+    if let Some(id) = (0..bvh.input_triangles).find(|&id| slots_of_triangle[id] > 1 && corners_bounded[id] != [true; 3])
+    {
+        return Err(format!("a corner of triangle {id} is in none of its leaves"));
     }
     Ok(())
 }

@@ -65,7 +65,7 @@ impl<const W: usize, L> WideBvh<W, L> {
 
 /// Fixed pseudo-random numbers in `[0, 1)` for the unit tests (xorshift64, 24 bits a number).
 #[cfg(test)]
-fn unit_floats(seed: u64) -> impl FnMut() -> f32 {
+pub(in crate::accel) fn unit_floats(seed: u64) -> impl FnMut() -> f32 {
     let mut state = seed;
     move || {
         state ^= state << 13;
