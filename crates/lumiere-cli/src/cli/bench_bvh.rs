@@ -55,16 +55,17 @@ pub fn run(args: &BenchBvhArgs) -> Result<()> {
                     median_seconds(args.repeats, || drop(build(&world.scene().mesh, BuildPreset::Default, world.isa())))
                 });
             builds.push(format!(
-                "| {} | {} | {triangles} | {load_ms:.0} | {build_ms:.0} | {} / {} | {} | {:.1} | {:.0} |",
+                "| {} | {} | {triangles} | {} | {load_ms:.0} | {build_ms:.0} | {} / {} | {} | {:.1} | {:.0} |",
                 bench.name,
                 n,
+                binary.slot_count(),
                 binary.nodes().len(),
                 world.accel().node_count(),
                 costs.join(" / "),
                 bytes as f64 / triangles as f64,
                 peak_rss_mib().unwrap_or(f64::NAN),
             ));
-            json.push(serde_json::json!({"scene": bench.name, "threads": n, "what": "build", "triangles": triangles, "load_ms": load_ms, "build_ms": build_ms, "binary_nodes": binary.nodes().len(), "wide_nodes": world.accel().node_count(), "bytes_per_triangle": bytes as f64 / triangles as f64}));
+            json.push(serde_json::json!({"scene": bench.name, "threads": n, "what": "build", "triangles": triangles, "references": binary.slot_count(), "load_ms": load_ms, "build_ms": build_ms, "binary_nodes": binary.nodes().len(), "wide_nodes": world.accel().node_count(), "bytes_per_triangle": bytes as f64 / triangles as f64}));
         }
         for set in &sets {
             let wrong = mismatches(&binary, world.accel(), set);
@@ -97,9 +98,9 @@ pub fn run(args: &BenchBvhArgs) -> Result<()> {
         }
     }
     output::print(
-        "| scene | threads | triangles | load ms | build ms | nodes binary / wide | SAH fast / default / high | bytes/tri | peak RSS MiB |",
+        "| scene | threads | triangles | references | load ms | build ms | nodes binary / wide | SAH fast / default / high | bytes/tri | peak RSS MiB |",
     )?;
-    output::print("|---|---|---|---|---|---|---|---|---|")?;
+    output::print("|---|---|---|---|---|---|---|---|---|---|")?;
     for row in &builds {
         output::print(row)?;
     }
