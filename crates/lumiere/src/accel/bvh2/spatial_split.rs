@@ -113,7 +113,8 @@ fn round_up(v: DVec3) -> Vec3A {
 }
 
 /// A triangle's corners sorted along one axis, for the sections of the spatial bins' planes. In
-/// f32: the bins only estimate the costs; the partition clips conservatively.
+/// f32, and a reference that is already a piece gets its end bins' pieces from the sections and
+/// corners inside them only: the bins estimate the costs; the partition clips conservatively.
 struct Slices {
     corners: [Vec3A; 3],
     axis: usize,
@@ -150,11 +151,8 @@ impl Slices {
 
 /// The piece of `r`'s triangle in `lo ..= hi` along `axis`, within `r`'s own box (which may
 /// already be a piece).
-fn piece(ctx_corners: [Vec3; 3], r: &PrimRef, axis: usize, lo: f32, hi: f32) -> Option<Box3A> {
-    let clipped = clip_triangle(ctx_corners, axis, lo, hi)?;
-    let own = r.bounds();
-    let bounds = Box3A { min: clipped.min.max(own.min), max: clipped.max.min(own.max) };
-    (!bounds.min.cmpgt(bounds.max).any()).then_some(bounds)
+fn piece(corners: [Vec3; 3], r: &PrimRef, axis: usize, lo: f32, hi: f32) -> Option<Box3A> {
+    clip_triangle(corners, axis, lo, hi)?.intersection(r.bounds())
 }
 
 /// The spatial bins of one axis: `B` slabs of `width` from `min`.
