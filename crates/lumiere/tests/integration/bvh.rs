@@ -324,6 +324,39 @@ fn spatial_splits_cut_large_triangles_and_answer_like_brute_force() {
     check_against_brute_force(&positions, &indices, &rays, "a room of large and small triangles");
 }
 
+/// A triangle wider than f32's range (its box's extent overflows to infinity, and so do the areas
+/// the build and the collapse weigh) among small ones and huge scattered ones: the trees are
+/// built and collapsed (the collapse plan once panicked on infinite costs) and answer like brute
+/// force.
+#[test]
+fn boxes_wider_than_the_f32_range_build_and_answer_like_brute_force() {
+    let mut rng = TestRng(99);
+    let mut positions = vec![
+        Vec3::new(-3e38, -3e38, 0.0),
+        Vec3::new(3e38, -3e38, 0.0),
+        Vec3::new(0.0, 3e38, 1e38),
+        Vec3::new(-1e-30, 0.0, 0.0),
+        Vec3::new(1e-30, 0.0, 0.0),
+        Vec3::new(0.0, 1e-30, 0.0),
+    ];
+    for _ in 0..300 {
+        let centre = rng.vec3(-1e37, 1e37);
+        positions.extend([0; 3].map(|_| centre + rng.vec3(-1e36, 1e36)));
+    }
+    let indices: Vec<[u32; 3]> = (0..positions.len() as u32 / 3).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
+    let rays: Vec<Ray> = (0..200)
+        .map(|i| {
+            let origin = rng.vec3(-2e37, 2e37) + Vec3::new(0.0, 0.0, 5e37);
+            if i % 2 == 0 {
+                Ray::new(origin, positions[indices[rng.below(indices.len())][0] as usize] - origin)
+            } else {
+                Ray::new(origin, rng.direction())
+            }
+        })
+        .collect();
+    check_against_brute_force(&positions, &indices, &rays, "boxes wider than the f32 range");
+}
+
 #[test]
 fn closed_mesh_rays_through_vertices_and_edges_never_leak() {
     let (positions, indices) = grid_cube(6);

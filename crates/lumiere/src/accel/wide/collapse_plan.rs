@@ -58,7 +58,9 @@ impl<const W: usize> CollapsePlan<W> {
         for slots in 2..=W {
             for to_left in 1..slots {
                 let cost = self.cost[left][to_left - 1] + self.cost[right][slots - to_left - 1];
-                if cost < spread[slots - 1].0 {
+                // The first spread is taken whatever its cost: boxes wider than f32's range have
+                // infinite areas, and a spread must still give each side a root.
+                if to_left == 1 || cost < spread[slots - 1].0 {
                     spread[slots - 1] = (cost, to_left as u8);
                 }
             }
