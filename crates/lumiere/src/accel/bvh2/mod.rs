@@ -1,6 +1,6 @@
-//! The binary BVH: the binned-SAH build (with spatial splits) every layout starts from, flat 32-byte nodes, a scalar
-//! closest-hit and occlusion traversal (the reference the wide kernels must match bit for bit), and
-//! the structural validator.
+//! The binary BVH: the binned-SAH build (with spatial splits) every layout starts from, flat
+//! 32-byte nodes, a scalar closest-hit and occlusion traversal (the reference the wide kernels must
+//! match bit for bit), and the structural validator.
 
 mod build;
 mod node;
