@@ -231,6 +231,21 @@ fn built_on_one_thread_and_three(positions: &[Vec3], indices: &[[u32; 3]]) -> (B
     (one, three)
 }
 
+/// The trees built on one thread and on three give the same hits, and brute force's.
+fn check_threads_agree_with_brute_force(
+    one: &Bvh,
+    three: &Bvh,
+    positions: &[Vec3],
+    indices: &[[u32; 3]],
+    rays: &[Ray],
+    context: &str,
+) {
+    for ray in rays {
+        assert_eq!(one.intersect(ray), three.intersect(ray), "{context} {ray:?}");
+    }
+    check_against_brute_force(positions, indices, rays, context);
+}
+
 /// Trees large enough to be built in parallel (subtrees of 4,096 triangles and more split on rayon,
 /// then written into one array) are the same node for node on one thread and on three, keep their
 /// structure valid, and answer like brute force; some of the triangles are degenerate, so the
@@ -262,10 +277,7 @@ fn large_trees_are_the_same_on_any_thread_count_and_match_brute_force() {
             }
         })
         .collect();
-    for ray in &rays {
-        assert_eq!(one.intersect(ray), three.intersect(ray), "{ray:?}");
-    }
-    check_against_brute_force(&positions, &indices, &rays, "20,000 triangles");
+    check_threads_agree_with_brute_force(&one, &three, &positions, &indices, &rays, "20,000 triangles");
 }
 
 /// A room of large triangles (walls, floor, long slanted boards) filled with small ones, the
@@ -318,10 +330,14 @@ fn spatial_splits_cut_large_triangles_and_answer_like_brute_force() {
             }
         })
         .collect();
-    for ray in &rays {
-        assert_eq!(one.intersect(ray), three.intersect(ray), "{ray:?}");
-    }
-    check_against_brute_force(&positions, &indices, &rays, "a room of large and small triangles");
+    check_threads_agree_with_brute_force(
+        &one,
+        &three,
+        &positions,
+        &indices,
+        &rays,
+        "a room of large and small triangles",
+    );
 }
 
 /// A triangle wider than f32's range (its box's extent overflows to infinity, and so do the areas

@@ -15,12 +15,13 @@ use rayon::prelude::*;
 use super::build::{BINNING_CHUNK, Bin, Box3A, Context, NodeBounds, PARALLEL_BINNING_THRESHOLD, PrimRef};
 
 /// Spatial splits are tried where the object split's children overlap by more than this share of
-/// the root's area (the paper's alpha; its 1e-5 built the same staircase tree, SAH cost 27.0,
+/// the root's area (the paper's alpha; its 1e-5 built a staircase tree of the same SAH cost, 27.0,
 /// taking 40% longer)...
 pub(super) const OVERLAP_SHARE: f64 = 1e-3;
 
 /// ...and by more than this share of the node's extent along the split's axis: without it the
-/// bunny-1m's build took twice as long, to cut ten triangles.
+/// bunny-1m's build took twice as long (427-450 ms at 2 threads); with it the bunny's tree is within
+/// ten nodes of the uncut one.
 pub(super) const OVERLAP_THICKNESS: f32 = 0.05;
 
 /// Extra references the whole build may add, as a share of the triangles.

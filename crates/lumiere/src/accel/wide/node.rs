@@ -35,9 +35,15 @@ impl<const W: usize> WideNode<W> {
 
     /// No children: every box NaN, every slot empty.
     pub(super) fn empty() -> Self {
-        let mut node = WideNode { bounds: [[f32::NAN; W]; 6], children: [EMPTY_CHILD; W], near_to_far: [0; W] };
-        node.order_children();
-        node
+        WideNode { bounds: [[f32::NAN; W]; 6], children: [EMPTY_CHILD; W], near_to_far: Self::slot_order() }
+    }
+
+    /// Every octant's order the slots' own, as [`WideNode::order_children`] orders empty slots:
+    /// an empty node's orders, without sorting them (the collapse makes each node empty first).
+    fn slot_order() -> [u32; W] {
+        let octant: u32 = (0..W).fold(0, |order, k| order | (k as u32) << (4 * k));
+        let word = (0..8 / W).fold(0, |word, i| word | octant << (i * 4 * W));
+        [word; W]
     }
 
     /// Octant `octant`'s order of the slots (bit `a` of the octant set where the direction's
@@ -136,5 +142,6 @@ mod tests {
         check_orders::<4>([Some(1.0), Some(-1.0), None, Some(4.0)]);
         // An empty node keeps slot order.
         assert!(orders(&WideNode::<8>::empty()).iter().all(|order| *order == (0..8).collect::<Vec<_>>()));
+        assert!(orders(&WideNode::<4>::empty()).iter().all(|order| *order == (0..4).collect::<Vec<_>>()));
     }
 }
