@@ -45,6 +45,10 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
             nodes: Vec::with_capacity(interior.max(1)),
             blocks,
             triangle_count: bvh.triangle_count(),
+            moderate_extent: {
+                let bounds = root.bounds();
+                (bounds.min.abs().max(bounds.max.abs())).max_element() < super::SPAN_CULL_EXTENT
+            },
             kernel: PhantomData,
         };
         if let Some(plan) = plan {

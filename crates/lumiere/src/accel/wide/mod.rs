@@ -32,6 +32,9 @@ pub struct WideBvh<const W: usize, L> {
     pub(super) nodes: Vec<WideNode<W>>,
     pub(super) blocks: Vec<TriangleBlock<W>>,
     triangle_count: usize,
+    /// Whether every corner lies within [`SPAN_CULL_EXTENT`] of the origin on every axis: where
+    /// packets may cull whole blocks by the span of their rays (`packet.rs`, `PacketSpan`).
+    moderate_extent: bool,
     /// The kernel is part of the type, so that the accel a world chose fixes its traversal code.
     /// (`fn() -> L`: the BVH owns no `L`, and stays `Send` and `Sync` whatever `L` is.)
     kernel: PhantomData<fn() -> L>,
@@ -62,6 +65,12 @@ impl<const W: usize, L> WideBvh<W, L> {
         self.nodes.len() * size_of::<WideNode<W>>() + self.blocks.len() * size_of::<TriangleBlock<W>>()
     }
 }
+
+/// The largest coordinate, of a corner or of a packet's origin, for which packets cull blocks by
+/// the span of their rays: below it, no product of two sheared corner coordinates overflows f32
+/// (each is at most `2 * 2 * SPAN_CULL_EXTENT`, and 1.6e37 < f32::MAX), which the cull's proof
+/// needs.
+pub(super) const SPAN_CULL_EXTENT: f32 = 1e18;
 
 /// Fixed pseudo-random numbers in `[0, 1)` for the unit tests (xorshift64, 24 bits a number).
 #[cfg(test)]

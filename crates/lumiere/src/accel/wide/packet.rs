@@ -12,10 +12,10 @@
 
 use glam::Vec3;
 
-use super::WideBvh;
 use super::leaf::{self, LEAF_BIT};
 use super::node::{EMPTY_CHILD, TriangleBlock, WideNode};
 use super::traverse::Stack;
+use super::{SPAN_CULL_EXTENT, WideBvh};
 use crate::accel::Hit;
 use crate::accel::simd::{F32x4, Lanes, lanes_of, max_ps, min_ps};
 use crate::accel::slab::{BOX_EXPANSION, PRUNE_SLACK, safe_reciprocal};
@@ -69,6 +69,80 @@ pub struct RayPacket<const N: usize> {
     inv_dir: [[f32; N]; 3],
     shear: [[f32; N]; 3],
     tmax: [f32; N],
+}
+
+/// What bounds every lane's view of a triangle: per axis, the least and the greatest origin
+/// coordinate of any lane, and the least and the greatest of the watertight test's shears `sx`,
+/// `sy`. Enough to rule out, a block at a time, the triangles that no lane can hit
+/// ([`PacketSpan::outside`]): a camera packet's rays pass through a few pixels, and most of a
+/// leaf's triangles lie wholly to one side of all of them.
+struct PacketSpan {
+    origin: [[f32; 2]; 3],
+    shear: [[f32; 2]; 2],
+}
+
+impl PacketSpan {
+    /// The triangles of `block` (bit per triangle) that no lane of the packet this span bounds
+    /// can hit, the packet's axis permutation being `permutation`.
+    ///
+    /// The watertight test moves each corner into the ray's frame: `x = (p[kx] - o[kx]) - sx *
+    /// (p[kz] - o[kz])`, and `y` alike with `ky` and `sy`, each operation rounded. Every rounded
+    /// operation is monotone in each operand, so `x` is monotone in `o[kx]`, in `o[kz]` and in
+    /// `sx` separately, and its extremes over the span come from its corners: the same operations
+    /// on the span's bounds give, bit for bit, a least and a greatest `x` between which every
+    /// lane's lies. A triangle whose three corners have `x < 0` for every lane (or `x > 0`, or the
+    /// same with `y`) leaves the origin of every lane's 2D frame strictly outside it, for the
+    /// rounded coordinates the test works with. The test then cannot report a hit: its edge
+    /// functions are differences of rounded products, so each has the exact sign of the
+    /// difference (the origin being outside, not all the same) or is 0, and a 0 sends the lane to
+    /// the same products in f64, whose signs are exact. That holds while no product overflows,
+    /// which [`SPAN_CULL_EXTENT`] ensures (the shears are at most 1 in magnitude: `kz` is the
+    /// direction's dominant axis).
+    #[inline(always)]
+    fn outside<const W: usize>(&self, permutation: [usize; 3], block: &TriangleBlock<W>) -> u32 {
+        let [kx, ky, kz] = permutation;
+        let [depth_origin_low, depth_origin_high] = self.origin[kz];
+        // Per frame axis (x, y), the greatest and the least coordinate of any corner for any lane.
+        let mut highest = [[f32::NEG_INFINITY; W]; 2];
+        let mut lowest = [[f32::INFINITY; W]; 2];
+        for corner in &block.vertices {
+            for (axis, k) in [kx, ky].into_iter().enumerate() {
+                let [shear_low, shear_high] = self.shear[axis];
+                let [origin_low, origin_high] = self.origin[k];
+                for t in 0..W {
+                    let (depth_low, depth_high) = (corner[kz][t] - depth_origin_high, corner[kz][t] - depth_origin_low);
+                    let products = [
+                        shear_low * depth_low,
+                        shear_low * depth_high,
+                        shear_high * depth_low,
+                        shear_high * depth_high,
+                    ];
+                    let least = min_ps(min_ps(products[0], products[1]), min_ps(products[2], products[3]));
+                    let greatest = max_ps(max_ps(products[0], products[1]), max_ps(products[2], products[3]));
+                    highest[axis][t] = max_ps(highest[axis][t], (corner[k][t] - origin_low) - least);
+                    lowest[axis][t] = min_ps(lowest[axis][t], (corner[k][t] - origin_high) - greatest);
+                }
+            }
+        }
+        (0..W).fold(0, |mask, t| {
+            let out = highest[0][t] < 0.0 || lowest[0][t] > 0.0 || highest[1][t] < 0.0 || lowest[1][t] > 0.0;
+            mask | u32::from(out) << t
+        })
+    }
+}
+
+/// The least and the greatest of `values`, four lanes at a time (as [`least`]).
+#[inline(always)]
+fn range<const N: usize>(values: &[f32; N]) -> [f32; 2] {
+    let mut quads = values.chunks_exact(4);
+    let (mut low, mut high) = (F32x4::splat(f32::INFINITY), F32x4::splat(f32::NEG_INFINITY));
+    for quad in &mut quads {
+        let quad = F32x4::load(quad.try_into().expect("four lanes"));
+        (low, high) = (low.min(quad), high.max(quad));
+    }
+    let ([a, b, c, d], [e, f, g, h]) = (low.to_array(), high.to_array());
+    let init = [min_ps(min_ps(a, b), min_ps(c, d)), max_ps(max_ps(e, f), max_ps(g, h))];
+    quads.remainder().iter().fold(init, |[low, high], &v| [min_ps(low, v), max_ps(high, v)])
 }
 
 /// The origin that all of a packet's rays start from, and the range of each axis's reciprocal
@@ -138,6 +212,15 @@ impl<const N: usize> RayPacket<N> {
             shared.origin[axis] = origin;
         }
         Some(shared)
+    }
+
+    /// The span of the packet's origins and shears, if its origins lie within
+    /// [`SPAN_CULL_EXTENT`] (the scene's corners must too: see [`PacketSpan::outside`]).
+    #[inline(always)]
+    fn span(&self) -> Option<PacketSpan> {
+        let origin = [range(&self.origin[0]), range(&self.origin[1]), range(&self.origin[2])];
+        let moderate = origin.iter().all(|[low, high]| -SPAN_CULL_EXTENT < *low && *high < SPAN_CULL_EXTENT);
+        moderate.then(|| PacketSpan { origin, shear: [range(&self.shear[0]), range(&self.shear[1])] })
     }
 
     /// For a packet whose rays share their origin (`shared`, from [`RayPacket::shared_origin`]),
@@ -438,6 +521,7 @@ impl<const W: usize, L> WideBvh<W, L> {
         let use_boxes = BoxFirst::for_next_packet();
         let (mut boxes_tested, mut boxes_ruled_out) = (0u32, 0u32);
         let shared = packet.shared_origin();
+        let span = if self.moderate_extent { packet.span() } else { None };
         while let Some((reference, nearest)) = stack.pop() {
             // No lane can find anything closer in there (the single-ray pruning, for the packet).
             if nearest > farthest_limit * PRUNE_SLACK {
@@ -449,7 +533,12 @@ impl<const W: usize, L> WideBvh<W, L> {
                 continue;
             }
             for block in &self.blocks[leaf::blocks::<W>(reference)] {
-                for lane_in_block in (0..W).filter(|&l| !is_padding(block, l)) {
+                // A `match`, not `map_or`: a closure may be left out of line, outside the ISA.
+                let outside = match &span {
+                    Some(span) => span.outside(packet.permutation, block),
+                    None => 0,
+                };
+                for lane_in_block in (0..W).filter(|&l| outside & (1 << l) == 0 && !is_padding(block, l)) {
                     if use_boxes {
                         boxes_tested += 1;
                         if !packet.may_hit(block, lane_in_block, &limit) {
@@ -503,6 +592,7 @@ impl<const W: usize, L> WideBvh<W, L> {
         let mut out = [[0.0f32; N]; 3];
         let use_boxes = BoxFirst::for_next_packet();
         let (mut boxes_tested, mut boxes_ruled_out) = (0u32, 0u32);
+        let span = if self.moderate_extent { packet.span() } else { None };
         while let Some((reference, _)) = stack.pop() {
             if reference & LEAF_BIT == 0 {
                 // Shadow packets share an end point, not an origin: no node test for them.
@@ -510,7 +600,12 @@ impl<const W: usize, L> WideBvh<W, L> {
                 continue;
             }
             for block in &self.blocks[leaf::blocks::<W>(reference)] {
-                for lane_in_block in (0..W).filter(|&l| !is_padding(block, l)) {
+                // A `match`, not `map_or`: a closure may be left out of line, outside the ISA.
+                let outside = match &span {
+                    Some(span) => span.outside(packet.permutation, block),
+                    None => 0,
+                };
+                for lane_in_block in (0..W).filter(|&l| outside & (1 << l) == 0 && !is_padding(block, l)) {
                     if use_boxes {
                         boxes_tested += 1;
                         if !packet.may_hit(block, lane_in_block, &limit) {
@@ -590,6 +685,91 @@ mod tests {
             }
         }
         assert!(checked > 10_000 && entered > 2_000, "{checked} children checked, {entered} entered");
+    }
+
+    /// A block's triangles culled by a packet's span are hit by none of its lanes, not even by the
+    /// rounding of the watertight test: packets from one origin and from origins a pixel apart
+    /// (gKit's camera) or far apart, aimed exactly at triangle corners and between them, against
+    /// slivers, tiny and large triangles around the aim.
+    #[test]
+    fn a_span_culls_only_triangles_no_lane_hits() {
+        let mut next = crate::accel::wide::unit_floats(0x2545_F491_4F6C_DD1Du64);
+        let (mut culled, mut kept_and_hit, mut culled_near) = (0, 0, 0);
+        for round in 0..3000 {
+            // Eight triangles around a point, from slivers to large ones.
+            let centre = Vec3::new(next() * 4.0 - 2.0, next() * 4.0 - 2.0, next() * 4.0 - 2.0);
+            let scale = [1e-4, 1e-2, 1.0][round % 3];
+            let mut block = TriangleBlock::<8> { vertices: [[[0.0; 8]; 3]; 3], ids: [0; 8] };
+            let mut corners = Vec::new();
+            for t in 0..8 {
+                // Half of them meet at the centre, as a mesh's triangles meet at a vertex.
+                let a = if t % 2 == 0 {
+                    centre
+                } else {
+                    centre + Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5) * scale
+                };
+                let b = a + Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5) * scale;
+                // A sliver: the third corner almost on the line through the first two.
+                let c = if t % 3 == 0 {
+                    a + (b - a) * (next() * 3.0 - 1.0) + Vec3::splat(scale * 1e-6)
+                } else {
+                    a + Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5) * scale
+                };
+                for (corner, p) in [a, b, c].into_iter().enumerate() {
+                    for axis in 0..3 {
+                        block.vertices[corner][axis][t] = p[axis];
+                    }
+                }
+                block.ids[t] = t as u32;
+                corners.extend([a, b, c]);
+            }
+            // Sixteen rays from one origin, from origins a pixel apart, or from far apart, aimed
+            // as a tile of pixels is: around a point (a corner, or between two), half of them
+            // exactly at it.
+            let eye = centre + Vec3::new(next() - 0.5, next() - 0.5, 3.0 + next());
+            let spread = [0.0, 1e-3 * scale, 0.5][(round / 3) % 3];
+            let pick = |u: f32| corners[(u * corners.len() as f32) as usize];
+            let focus = match (next() * 3.0) as usize {
+                0 => centre,
+                1 => pick(next()),
+                _ => pick(next()).lerp(pick(next()), next()),
+            };
+            let jitter = scale * [1e-6, 1e-3, 0.1][(round / 9) % 3];
+            let rays: [Ray; 16] = std::array::from_fn(|lane| {
+                let origin = eye + Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5) * spread;
+                let offset = Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5) * jitter;
+                let aim = if lane % 2 == 0 { focus } else { focus + offset };
+                Ray::new(origin, aim - origin)
+            });
+            let key = PacketKey::of(&rays[0]);
+            if rays.iter().any(|ray| PacketKey::of(ray) != key) {
+                continue;
+            }
+            let packet = RayPacket::new(key, &rays);
+            let outside = packet.span().expect("moderate origins").outside(packet.permutation, &block);
+            for t in 0..8 {
+                let corner = |c: usize| Vec3::from_array([0, 1, 2].map(|axis| block.vertices[c][axis][t]));
+                let hits: Vec<usize> = (0..16)
+                    .filter(|&lane| {
+                        intersect_triangle(&packet.watertight(lane), f32::INFINITY, corner(0), corner(1), corner(2))
+                            .is_some()
+                    })
+                    .collect();
+                if outside & (1 << t) != 0 {
+                    assert!(hits.is_empty(), "triangle {t} of {block:?} culled, yet lanes {hits:?} of {rays:?} hit it");
+                    culled += 1;
+                    // Culled though every even lane is aimed exactly at one of its corners.
+                    let near = focus == centre && t % 2 == 0;
+                    culled_near += usize::from(near);
+                } else if !hits.is_empty() {
+                    kept_and_hit += 1;
+                }
+            }
+        }
+        assert!(
+            culled > 5_000 && kept_and_hit > 2_000 && culled_near > 20,
+            "{culled} culled ({culled_near} aimed at a corner), {kept_and_hit} kept and hit"
+        );
     }
 
     /// The key's permutation and the packet's shears are `WatertightRay`'s, for directions along
