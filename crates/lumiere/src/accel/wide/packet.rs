@@ -131,6 +131,34 @@ impl PacketSpan {
     }
 }
 
+/// A packet's span, worked out when it first reaches a leaf (many camera packets reach none).
+enum LazySpan {
+    Unknown,
+    /// `None` where the packet's origins or the scene's corners are too far out to cull by it.
+    Known(Option<PacketSpan>),
+}
+
+impl LazySpan {
+    /// [`PacketSpan::outside`] for `packet`'s span (none where `moderate_extent` is false: the
+    /// scene's corners lie too far out).
+    #[inline(always)]
+    fn outside<const N: usize, const W: usize>(
+        &mut self,
+        packet: &RayPacket<N>,
+        moderate_extent: bool,
+        block: &TriangleBlock<W>,
+    ) -> u32 {
+        if let LazySpan::Unknown = self {
+            *self = LazySpan::Known(if moderate_extent { packet.span() } else { None });
+        }
+        // A `match`, not `map_or`: a closure may be left out of line, outside the ISA.
+        match self {
+            LazySpan::Known(Some(span)) => span.outside(packet.permutation, block),
+            _ => 0,
+        }
+    }
+}
+
 /// The least and the greatest of `values`, four lanes at a time (as [`least`]).
 #[inline(always)]
 fn range<const N: usize>(values: &[f32; N]) -> [f32; 2] {
@@ -521,7 +549,7 @@ impl<const W: usize, L> WideBvh<W, L> {
         let use_boxes = BoxFirst::for_next_packet();
         let (mut boxes_tested, mut boxes_ruled_out) = (0u32, 0u32);
         let shared = packet.shared_origin();
-        let span = if self.moderate_extent { packet.span() } else { None };
+        let mut span = LazySpan::Unknown;
         while let Some((reference, nearest)) = stack.pop() {
             // No lane can find anything closer in there (the single-ray pruning, for the packet).
             if nearest > farthest_limit * PRUNE_SLACK {
@@ -533,11 +561,7 @@ impl<const W: usize, L> WideBvh<W, L> {
                 continue;
             }
             for block in &self.blocks[leaf::blocks::<W>(reference)] {
-                // A `match`, not `map_or`: a closure may be left out of line, outside the ISA.
-                let outside = match &span {
-                    Some(span) => span.outside(packet.permutation, block),
-                    None => 0,
-                };
+                let outside = span.outside(packet, self.moderate_extent, block);
                 for lane_in_block in (0..W).filter(|&l| outside & (1 << l) == 0 && !is_padding(block, l)) {
                     if use_boxes {
                         boxes_tested += 1;
@@ -592,7 +616,7 @@ impl<const W: usize, L> WideBvh<W, L> {
         let mut out = [[0.0f32; N]; 3];
         let use_boxes = BoxFirst::for_next_packet();
         let (mut boxes_tested, mut boxes_ruled_out) = (0u32, 0u32);
-        let span = if self.moderate_extent { packet.span() } else { None };
+        let mut span = LazySpan::Unknown;
         while let Some((reference, _)) = stack.pop() {
             if reference & LEAF_BIT == 0 {
                 // Shadow packets share an end point, not an origin: no node test for them.
@@ -600,11 +624,7 @@ impl<const W: usize, L> WideBvh<W, L> {
                 continue;
             }
             for block in &self.blocks[leaf::blocks::<W>(reference)] {
-                // A `match`, not `map_or`: a closure may be left out of line, outside the ISA.
-                let outside = match &span {
-                    Some(span) => span.outside(packet.permutation, block),
-                    None => 0,
-                };
+                let outside = span.outside(packet, self.moderate_extent, block);
                 for lane_in_block in (0..W).filter(|&l| outside & (1 << l) == 0 && !is_padding(block, l)) {
                     if use_boxes {
                         boxes_tested += 1;
