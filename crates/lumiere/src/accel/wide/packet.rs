@@ -79,6 +79,8 @@ pub struct RayPacket<const N: usize> {
 struct PacketSpan {
     origin: [[f32; 2]; 3],
     shear: [[f32; 2]; 2],
+    /// Whether every lane starts at the same point (a pinhole camera's packets): half the work.
+    one_origin: bool,
 }
 
 impl PacketSpan {
@@ -109,6 +111,18 @@ impl PacketSpan {
             for (axis, k) in [kx, ky].into_iter().enumerate() {
                 let [shear_low, shear_high] = self.shear[axis];
                 let [origin_low, origin_high] = self.origin[k];
+                if self.one_origin {
+                    // One depth a corner: its products with the two shears bound all.
+                    for t in 0..W {
+                        let depth = corner[kz][t] - depth_origin_low;
+                        let (low, high) = (shear_low * depth, shear_high * depth);
+                        let (least, greatest) = (min_ps(low, high), max_ps(low, high));
+                        let relative = corner[k][t] - origin_low;
+                        highest[axis][t] = max_ps(highest[axis][t], relative - least);
+                        lowest[axis][t] = min_ps(lowest[axis][t], relative - greatest);
+                    }
+                    continue;
+                }
                 for t in 0..W {
                     let (depth_low, depth_high) = (corner[kz][t] - depth_origin_high, corner[kz][t] - depth_origin_low);
                     let products = [
@@ -248,7 +262,8 @@ impl<const N: usize> RayPacket<N> {
     fn span(&self) -> Option<PacketSpan> {
         let origin = [range(&self.origin[0]), range(&self.origin[1]), range(&self.origin[2])];
         let moderate = origin.iter().all(|[low, high]| -SPAN_CULL_EXTENT < *low && *high < SPAN_CULL_EXTENT);
-        moderate.then(|| PacketSpan { origin, shear: [range(&self.shear[0]), range(&self.shear[1])] })
+        let one_origin = origin.iter().all(|[low, high]| low == high);
+        moderate.then(|| PacketSpan { origin, shear: [range(&self.shear[0]), range(&self.shear[1])], one_origin })
     }
 
     /// For a packet whose rays share their origin (`shared`, from [`RayPacket::shared_origin`]),
