@@ -282,21 +282,34 @@ impl Accel {
         mut packet: impl FnMut(&RayPacket<N>, u32),
     ) -> u32 {
         const { assert!(N <= 32, "lane masks are u32") };
-        let keys: [PacketKey; N] = std::array::from_fn(|lane| PacketKey::of(&rays[lane]));
+        // Plain loops: closures passed to `array::from_fn` or `fold` may be left out of line (the
+        // keys were a call per lane, a tenth of the bunny's camera rays).
+        let mut keys = [PacketKey::ALONE; N];
+        for (key, ray) in keys.iter_mut().zip(rays) {
+            *key = PacketKey::of(ray);
+        }
         let mut alone = 0;
         let mut remaining = live;
         while remaining != 0 {
             let first = remaining.trailing_zeros() as usize;
             let key = keys[first];
-            let group = (0..N).fold(0u32, |m, lane| m | u32::from(keys[lane] == key) << lane) & remaining;
+            let mut group = 0u32;
+            for (lane, &other) in keys.iter().enumerate() {
+                group |= u32::from(other == key) << lane;
+            }
+            group &= remaining;
             remaining &= !group;
             if group.count_ones() < MIN_PACKET_RAYS || key == PacketKey::ALONE {
                 alone |= group;
                 continue;
             }
             // Lanes outside the group carry the group's first ray, so that every lane shares the key.
-            let members: [Ray; N] =
-                std::array::from_fn(|lane| rays[if group & (1 << lane) != 0 { lane } else { first }]);
+            let mut members = *rays;
+            for (lane, member) in members.iter_mut().enumerate() {
+                if group & (1 << lane) == 0 {
+                    *member = rays[first];
+                }
+            }
             self.simd(
                 #[inline(always)]
                 || packet(&RayPacket::new(key, &members), group),

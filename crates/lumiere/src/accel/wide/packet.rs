@@ -42,8 +42,9 @@ impl PacketKey {
             return PacketKey::ALONE;
         }
         let kz = dominant_axis(d) as u8;
-        let negative =
-            [d.x, d.y, d.z].iter().enumerate().fold(0u8, |m, (axis, v)| m | u8::from(v.is_sign_negative()) << axis);
+        let negative = u8::from(d.x.is_sign_negative())
+            | u8::from(d.y.is_sign_negative()) << 1
+            | u8::from(d.z.is_sign_negative()) << 2;
         PacketKey(negative | kz << 3)
     }
 
