@@ -223,7 +223,6 @@ pub(super) fn best_spatial_split<const W: usize, const B: usize>(
         } else {
             grid.bin::<W, B>(ctx, refs)
         };
-        let (min, plane) = (grid.min, |k: usize| grid.plane(k));
         let mut right = [SpatialBin::EMPTY; B];
         let mut acc = SpatialBin::EMPTY;
         for k in (1..B).rev() {
@@ -233,9 +232,9 @@ pub(super) fn best_spatial_split<const W: usize, const B: usize>(
         let mut left = SpatialBin::EMPTY;
         for k in 1..B {
             left = left.merge(bins[k - 1]);
-            let position = plane(k);
+            let position = grid.plane(k);
             // Both children must shrink along the axis, or the recursion would not end.
-            if left.entries == 0 || right[k].exits == 0 || !(min < position && position < bounds.max[axis]) {
+            if left.entries == 0 || right[k].exits == 0 || !(grid.min < position && position < bounds.max[axis]) {
                 continue;
             }
             let (l, r) = (

@@ -174,7 +174,8 @@ impl LazySpan {
     }
 }
 
-/// The least and the greatest of `values`, four lanes at a time (as [`least`]).
+/// The least and the greatest of `values`, four lanes at a time (a chain of dependent scalar steps
+/// otherwise); where only one is used, the other's operations are dropped.
 #[inline(always)]
 fn range<const N: usize>(values: &[f32; N]) -> [f32; 2] {
     let mut quads = values.chunks_exact(4);
@@ -324,7 +325,11 @@ impl<const N: usize> RayPacket<N> {
         for lane in 0..N {
             mask |= u32::from(near[lane] <= far[lane]) << lane;
         }
-        (mask, least(&near))
+        // The least entry of any lane, entering or not: a lower bound of the entering lanes' (all
+        // that ordering and pruning boxes need). The running minimum over the entering lanes it
+        // replaces compiled to a chain of `N` dependent scalar steps (a seventh of a packet's
+        // traversal on the bunny). A NaN lane would make it NaN, which prunes nothing.
+        (mask, range(&near)[0])
     }
 
     /// Whether any lane enters the box of triangle `lane_in_block` of `block` before `limit` (the
@@ -356,21 +361,6 @@ impl<const N: usize> RayPacket<N> {
         }
         (near, far)
     }
-}
-
-/// The least entry distance of any lane, entering or not: a lower bound of the entering lanes'
-/// (which is all that ordering and pruning boxes need), four lanes at a time. The running minimum
-/// over the entering lanes it replaces compiled to a chain of `N` dependent scalar steps (a seventh
-/// of a packet's traversal on the bunny). A NaN lane would make it NaN, which prunes nothing.
-#[inline(always)]
-fn least<const N: usize>(values: &[f32; N]) -> f32 {
-    let mut quads = values.chunks_exact(4);
-    let mut low = F32x4::splat(f32::INFINITY);
-    for quad in &mut quads {
-        low = low.min(F32x4::load(quad.try_into().expect("four lanes")));
-    }
-    let [a, b, c, d] = low.to_array();
-    quads.remainder().iter().fold(min_ps(min_ps(a, b), min_ps(c, d)), |m, &v| min_ps(m, v))
 }
 
 /// The closest hits found so far, one per lane (`t` infinite and id `u32::MAX` for none).
