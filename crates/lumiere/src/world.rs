@@ -8,7 +8,7 @@ use glam::{Vec2, Vec3};
 use crate::accel::simd::lanes_of;
 use crate::accel::{Accel, BuildPreset, Hit, Isa, OriginBatch, Region};
 use crate::geometry::surface::SurfacePoint;
-use crate::geometry::surface_lanes::HitCorners;
+use crate::geometry::surface_lanes::{HitCorners, SurfaceRows};
 use crate::lights::LightSet;
 use crate::materials::{Material, MaterialBsdf, MaterialKind};
 use crate::math::Ray;
@@ -150,12 +150,31 @@ impl World {
     /// texture there, or its `Kd`.
     #[inline]
     pub fn bsdf(&self, surface: &SurfacePoint) -> MaterialBsdf {
-        let id = surface.material as usize;
-        let base = match self.texture_of_material[id] {
-            Some(texture) => self.textures.sample(texture, surface.uv),
+        self.kinds[surface.material as usize].bsdf(self.base_colour(surface.material, surface.uv))
+    }
+
+    /// The reflectance of the [`World::bsdf`] of material `material` at texture coordinates `uv`,
+    /// if that BSDF is Lambertian: what lighting many diffuse receivers together needs, without
+    /// building (and copying) a whole BSDF for each.
+    #[inline]
+    pub fn lambert_reflectance(&self, material: u32, uv: Vec2) -> Option<Vec3> {
+        matches!(self.kinds[material as usize], MaterialKind::Lambert).then(|| self.base_colour(material, uv))
+    }
+
+    /// Material `material`'s colour at `uv`: its texture's there, or its `Kd`.
+    #[inline]
+    fn base_colour(&self, material: u32, uv: Vec2) -> Vec3 {
+        let id = material as usize;
+        match self.texture_of_material[id] {
+            Some(texture) => self.textures.sample(texture, uv),
             None => self.scene.materials[id].kd,
-        };
-        self.kinds[id].bsdf(base)
+        }
+    }
+
+    /// The material of triangle `triangle`, as a [`SurfacePoint`] on it holds it.
+    #[inline]
+    pub fn material_of(&self, triangle: u32) -> u32 {
+        self.scene.mesh.material_ids[triangle as usize]
     }
 
     /// Starts loading the records of `hit`'s triangle that shading reads first (whether it is a
@@ -341,6 +360,21 @@ impl World {
     /// ISA's width (`geometry/surface_lanes.rs`).
     #[inline]
     pub fn surfaces<const N: usize>(&self, rays: &[Ray; N], hits: &[Option<Hit>; N]) -> [SurfacePoint; N] {
+        let rows = self.surface_rows(rays, hits);
+        // A plain loop: through `array::from_fn` the points were a call per lane (materials 6% slower).
+        let mut points = [SurfacePoint::default(); N];
+        for (lane, hit) in hits.iter().enumerate() {
+            if let Some(hit) = hit {
+                points[lane] = rows.point(lane, hit.triangle, self.material_of(hit.triangle));
+            }
+        }
+        points
+    }
+
+    /// The vectors of [`World::surfaces`], rows by axis (lanes without a hit hold garbage): for
+    /// callers that go on working lane by lane in rows, without a point per lane.
+    #[inline]
+    pub fn surface_rows<const N: usize>(&self, rays: &[Ray; N], hits: &[Option<Hit>; N]) -> SurfaceRows<N> {
         let mesh = &self.scene.mesh;
         let mut corners = HitCorners::<N>::default();
         for (lane, hit) in hits.iter().enumerate() {
@@ -372,18 +406,10 @@ impl World {
             (corners.u[lane], corners.v[lane]) = (hit.u, hit.v);
             set_row(&mut corners.dir, lane, rays[lane].dir);
         }
-        let rows = self.simd_256(
+        self.simd_256(
             #[inline(always)]
             || corners.surface_rows(),
-        );
-        // A plain loop: through `array::from_fn` the points were a call per lane (materials 6% slower).
-        let mut points = [SurfacePoint::default(); N];
-        for (lane, hit) in hits.iter().enumerate() {
-            if let Some(hit) = hit {
-                points[lane] = rows.point(lane, hit.triangle, mesh.material_ids[hit.triangle as usize]);
-            }
-        }
-        points
+        )
     }
 
     fn interpolated_normal(&self, id: usize, w: f32, u: f32, v: f32) -> Option<Vec3> {

@@ -45,7 +45,14 @@ impl SurfacePoint {
     /// The origin for rays leaving towards `dir`: `p` moved off the surface on `dir`'s side.
     #[inline]
     pub fn offset_origin(&self, dir: Vec3) -> Vec3 {
-        let side = if self.ng.dot(dir) >= 0.0 { self.ng } else { -self.ng };
-        offset_ray_origin(self.p, side)
+        offset_origin(self.p, self.ng, dir)
     }
+}
+
+/// [`SurfacePoint::offset_origin`] of the point `p` with geometric normal `ng`, for callers that
+/// keep points in rows rather than as `SurfacePoint`s.
+#[inline]
+pub fn offset_origin(p: Vec3, ng: Vec3, dir: Vec3) -> Vec3 {
+    let side = if ng.dot(dir) >= 0.0 { ng } else { -ng };
+    offset_ray_origin(p, side)
 }

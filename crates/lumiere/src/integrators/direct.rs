@@ -278,7 +278,7 @@ impl ShadesClosestHit for Direct {
         if emitted != Vec3::ZERO {
             return emitted;
         }
-        let (frame, wo) = shading_frame(surface.ns, ray);
+        let (frame, wo) = shading_frame(surface.ns, ray.dir);
         let receiver = Receiver { surface, bsdf: world.bsdf(surface), frame, wo };
         // Every shadow ray leaves above the geometric surface (the others are skipped), so they
         // share one origin.

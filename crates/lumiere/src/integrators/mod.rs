@@ -200,10 +200,10 @@ impl<T: ShadesClosestHit> Integrator for T {
 }
 
 /// The shading frame at a surface (`z` = the shading normal) and the direction towards the viewer
-/// in it, for BSDF evaluation.
+/// (who looks along `view`) in it, for BSDF evaluation.
 #[inline]
-fn shading_frame(ns: Vec3, ray: &Ray) -> (Frame, Vec3) {
+fn shading_frame(ns: Vec3, view: Vec3) -> (Frame, Vec3) {
     let frame = Frame::from_normal(ns);
-    let wo = frame.to_local(-ray.dir.normalize());
+    let wo = frame.to_local(-view.normalize());
     (frame, wo)
 }

@@ -1,12 +1,13 @@
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 use super::{CameraPacket, Integrator, PACKET, SampleContext, shading_frame};
 use crate::accel::simd::{all_lanes, lanes_of};
 use crate::accel::{Hit, OriginBatch};
-use crate::geometry::surface::SurfacePoint;
+use crate::geometry::surface::{SurfacePoint, offset_origin};
+use crate::geometry::surface_lanes::SurfaceRows;
 use crate::lights::AreaLight;
-use crate::materials::{Bsdf, MaterialBsdf};
-use crate::math::rows::set_row;
+use crate::materials::{Bsdf, Lambert, MaterialBsdf};
+use crate::math::rows::{row, set_row};
 use crate::math::{Frame, Ray, offset_ray_origin};
 use crate::world::World;
 
@@ -20,8 +21,8 @@ impl Integrator for Shadows {
 
     fn radiance(&self, world: &World, ray: &Ray, ctx: &mut SampleContext) -> Vec3 {
         ctx.rays += 1;
-        let receiver = match Receiver::new(world, ray, world.intersect(ray), |hit| world.surface(ray, hit)) {
-            Ok(receiver) => receiver,
+        let receiver = match Receiver::lit_hit(world, ray, world.intersect(ray)) {
+            Ok(hit) => Receiver::new(world, ray, world.surface(ray, &hit)),
             Err(radiance) => return radiance,
         };
         let mut sum = Vec3::ZERO;
@@ -43,8 +44,8 @@ impl Integrator for Shadows {
     /// an end point, so they are as coherent as the camera rays). Each lane adds its lights in the
     /// same order as `radiance`, and asks the same test: the same bits.
     ///
-    /// Diffuse receivers (all of the lab's) are lit together, SoA ([`DiffuseLanes`]); any other
-    /// is lit one at a time by its [`Receiver`].
+    /// Diffuse receivers (all of the lab's) are lit together, their surface points kept in rows
+    /// ([`DiffuseLanes`]); any other is lit one at a time by its [`Receiver`].
     fn radiance_packet<'a>(
         &self,
         world: &World,
@@ -52,17 +53,32 @@ impl Integrator for Shadows {
         ctx: &mut SampleContext<'a>,
     ) -> [Vec3; PACKET] {
         let hits = world.intersect_packet(&camera.rays, camera.live);
-        let surfaces = world.surfaces(&camera.rays, &hits);
+        let rows = world.surface_rows(&camera.rays, &hits);
         ctx.rays += u64::from(camera.live.count_ones());
         let mut radiance = [Vec3::ZERO; PACKET];
         let mut diffuse = DiffuseLanes::default();
         let mut others: [Option<Receiver>; PACKET] = [None; PACKET];
         for lane in camera.lanes() {
-            match Receiver::new(world, &camera.rays[lane], hits[lane], |_| surfaces[lane]) {
-                Ok(Receiver { surface, lambertian: Some(f), .. }) => diffuse.set(lane, &surface, f),
-                Ok(receiver) => others[lane] = Some(receiver),
-                Err(value) => radiance[lane] = value,
+            let ray = &camera.rays[lane];
+            let hit = match Receiver::lit_hit(world, ray, hits[lane]) {
+                Ok(hit) => hit,
+                Err(value) => {
+                    radiance[lane] = value;
+                    continue;
+                }
+            };
+            let material = world.material_of(hit.triangle);
+            let uv = Vec2::new(rows.uv[0][lane], rows.uv[1][lane]);
+            match world.lambert_reflectance(material, uv) {
+                Some(reflectance) => diffuse.add(lane, reflectance),
+                None => others[lane] = Some(Receiver::new(world, ray, rows.point(lane, hit.triangle, material))),
             }
+        }
+        if diffuse.live != 0 {
+            world.simd(
+                #[inline(always)]
+                || diffuse.receive(&rows, &camera.rays),
+            );
         }
         let mut segments = camera.rays;
         let mut contributions = [Vec3::ZERO; PACKET];
@@ -92,8 +108,11 @@ impl Integrator for Shadows {
     }
 }
 
-/// The diffuse receivers of a packet, SoA: what lighting them needs, and nothing else (copying
-/// whole receivers into an array was a twentieth of the render).
+/// The diffuse receivers of a packet, SoA: what lighting them needs, and nothing else. Filled in
+/// two steps: each lane's reflectance ([`DiffuseLanes::add`]), then the rest straight from the
+/// packet's surface rows ([`DiffuseLanes::receive`]). Filled a whole [`Receiver`] at a time, the
+/// points went from rows to structs and back, and each lane's BSDF was copied through the stack
+/// in pieces wider than it was written in: hard shadows took 7% longer.
 #[derive(Default)]
 struct DiffuseLanes {
     /// Bit `i` set if lane `i` holds a diffuse receiver.
@@ -101,7 +120,7 @@ struct DiffuseLanes {
     p: [[f32; PACKET]; 3],
     ns: [[f32; PACKET]; 3],
     ng: [[f32; PACKET]; 3],
-    /// The BSDF's constant value.
+    /// The reflectance, then (once received) the BSDF's constant value.
     f: [[f32; PACKET]; 3],
     /// The surface point moved off the surface to the side of `ng`, where every shadow ray of a
     /// diffuse receiver leaves (`unshadowed` wants `wi` above `ng`): computed once, not per light.
@@ -109,17 +128,29 @@ struct DiffuseLanes {
 }
 
 impl DiffuseLanes {
-    fn set(&mut self, lane: usize, surface: &SurfacePoint, f: Vec3) {
+    /// Makes lane `lane` a diffuse receiver of reflectance `reflectance` (its [`Lambert`] BSDF's).
+    fn add(&mut self, lane: usize, reflectance: Vec3) {
         self.live |= 1 << lane;
-        let origin = surface.offset_origin(surface.ng);
-        for (rows, value) in [
-            (&mut self.p, surface.p),
-            (&mut self.ns, surface.ns),
-            (&mut self.ng, surface.ng),
-            (&mut self.f, f),
-            (&mut self.origin, origin),
-        ] {
-            set_row(rows, lane, value);
+        set_row(&mut self.f, lane, reflectance);
+    }
+
+    /// Takes the receivers' points from `rows`, the surface rows of the camera rays `rays`, and
+    /// works out each lane's BSDF constant and shadow-ray origin with the operations of
+    /// [`Receiver::new`] and [`SurfacePoint::offset_origin`] (the same bits), for every lane:
+    /// those that are not receivers compute values no one reads. Run it in the ISA's width.
+    #[inline(always)]
+    fn receive(&mut self, rows: &SurfaceRows<PACKET>, rays: &[Ray; PACKET]) {
+        (self.p, self.ns, self.ng) = (rows.p, rows.ns, rows.ng);
+        let mut view = [[0.0f32; PACKET]; 3];
+        for (lane, ray) in rays.iter().enumerate() {
+            set_row(&mut view, lane, ray.dir);
+        }
+        for lane in 0..PACKET {
+            let (p, ng) = (row(&rows.p, lane), row(&rows.ng, lane));
+            let (_, wo) = shading_frame(row(&rows.ns, lane), row(&view, lane));
+            let lambert = Lambert { reflectance: row(&self.f, lane) };
+            set_row(&mut self.f, lane, lambert.lambertian_eval(wo).unwrap_or(Vec3::ZERO));
+            set_row(&mut self.origin, lane, offset_origin(p, ng, ng));
         }
     }
 
@@ -276,25 +307,26 @@ struct Receiver {
 }
 
 impl Receiver {
-    /// The receiver at the camera ray's closest hit, whose surface point `surface` gives, or the
-    /// pixel's final value: black for a miss, the emission of a light seen from the side it faces
-    /// (from behind it is a surface).
+    /// The camera ray's closest hit if lights reach the pixel there, or else the pixel's final
+    /// value: black for a miss, the emission of a light seen from the side it faces (from behind
+    /// it is a surface).
     #[inline]
-    fn new(
-        world: &World,
-        ray: &Ray,
-        hit: Option<Hit>,
-        surface: impl FnOnce(&Hit) -> SurfacePoint,
-    ) -> Result<Receiver, Vec3> {
+    fn lit_hit(world: &World, ray: &Ray, hit: Option<Hit>) -> Result<Hit, Vec3> {
         let Some(hit) = hit else { return Err(Vec3::ZERO) };
         let emitted = world.emitted(hit.triangle, ray);
         if emitted != Vec3::ZERO {
             return Err(emitted);
         }
-        let surface = surface(&hit);
+        Ok(hit)
+    }
+
+    /// The receiver at `surface`, the surface point of a hit that [`Receiver::lit_hit`] let
+    /// through.
+    #[inline]
+    fn new(world: &World, ray: &Ray, surface: SurfacePoint) -> Receiver {
         let bsdf = world.bsdf(&surface);
-        let (frame, wo) = shading_frame(surface.ns, ray);
-        Ok(Receiver { surface, bsdf, lambertian: bsdf.lambertian_eval(wo), frame, wo })
+        let (frame, wo) = shading_frame(surface.ns, ray.dir);
+        Receiver { surface, bsdf, lambertian: bsdf.lambertian_eval(wo), frame, wo }
     }
 
     /// The shadow ray towards `light`'s centroid and the light it brings if nothing blocks it, or
