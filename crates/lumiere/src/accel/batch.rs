@@ -23,13 +23,10 @@
 //! rays per origin, a hemisphere in a large scene) or the region holds too many triangles, the
 //! batch falls back to ordinary traversal for each ray.
 
-use std::mem::MaybeUninit;
-
 use glam::{Vec3, Vec4};
 
-use super::bvh2::MAX_DEPTH;
 use super::simd::{F32x4, LaneMask, Lanes, all_lanes, min_ps};
-use super::wide::{LEAF_BIT, TriangleBlock, WideBvh, leaf_blocks};
+use super::wide::{LEAF_BIT, Stack, TriangleBlock, WideBvh, leaf_blocks};
 use crate::math::{Frame, Ray};
 
 /// Beyond this many candidate blocks (of four triangles), per-ray traversal is cheaper.
@@ -339,17 +336,11 @@ impl OriginBatch {
         // Triangles kept but not yet packed into a block of four, per part. (`prepare` gathers
         // only in a BVH with triangles, so it has a first block.)
         let mut pending: [_; P] = std::array::from_fn(|_| pending::Pending::new(&bvh.blocks[0]));
-        // Depth-first walk of the region; a wide level pushes at most `W` children (one row of the
-        // stack per level, as in `wide/traverse.rs`). Left uninitialised, as there: zeroing its
-        // 2.3 KB for every origin was a fifth of a soft-shadow render's instructions (callgrind).
-        let mut rows = [[MaybeUninit::<u32>::uninit(); W]; MAX_DEPTH + 1];
-        let stack = rows.as_flattened_mut();
-        stack[0] = MaybeUninit::new(0);
-        let mut len = 1;
-        while len > 0 {
-            len -= 1;
-            // SAFETY: entries below `len` were written before `len` grew past them.
-            let reference = unsafe { stack[len].assume_init() };
+        // Depth-first walk of the region, on the traversal's uninitialised stack: zeroing one for
+        // every origin was a fifth of a soft-shadow render's instructions (callgrind).
+        let mut stack = Stack::<W, u32>::new();
+        stack.push(0);
+        while let Some(reference) = stack.pop() {
             if reference & LEAF_BIT != 0 {
                 for block in &bvh.blocks[leaf_blocks::<W>(reference)] {
                     let kept = region.keeps_triangles::<W, L>(&block.vertices);
@@ -369,8 +360,7 @@ impl OriginBatch {
             while mask != 0 {
                 let slot = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
-                stack[len] = MaybeUninit::new(node.children[slot]);
-                len += 1;
+                stack.push(node.children[slot]);
             }
         }
         for (part, pending) in pending.iter_mut().enumerate() {
@@ -406,7 +396,7 @@ impl OriginBatch {
             let lane = kept.trailing_zeros() as usize;
             kept &= kept - 1;
             // Padding lanes repeat the block's last triangle: skip the repeats.
-            if lane > 0 && block.ids[lane] == block.ids[lane - 1] {
+            if block.is_padding(lane) {
                 continue;
             }
             if pending.len() == 4 {

@@ -27,7 +27,8 @@ pub struct Accel {
 }
 
 /// The layout and kernel of each ISA. The AVX kernels' types are private to `accel`, which keeps
-/// them out of reach of code that has not checked [`Isa::is_supported`].
+/// them out of reach of code that has not checked [`Isa::is_supported`]. Both AVX ISAs walk the
+/// tree with the AVX2 kernel; they differ in what [`Accel::simd`] compiles for.
 #[derive(Clone, Debug)]
 enum IsaBvh {
     Portable(WideBvh<4, F32xN<4>>),
@@ -70,14 +71,6 @@ impl Accel {
         Accel::collapse(&binary, isa, corners)
     }
 
-    /// Collapses a binary BVH (any; one built for `isa.width()` packs best) to `isa`'s layout.
-    ///
-    /// # Panics
-    /// If this CPU cannot run `isa`.
-    pub fn from_binary(binary: &Bvh, isa: Isa) -> Accel {
-        Accel::collapse(binary, isa, |slot| binary.vertices[slot])
-    }
-
     /// Collapses the tree of `binary`, with the corners of leaf-order slot `i` at `corners(i)`.
     fn collapse(binary: &Bvh, isa: Isa, corners: impl Fn(usize) -> [Vec3; 3] + Sync) -> Accel {
         assert!(isa.is_supported(), "this CPU cannot run the {isa} kernels");
@@ -94,11 +87,6 @@ impl Accel {
 
     pub fn isa(&self) -> Isa {
         self.isa
-    }
-
-    /// Children per node and triangles per leaf block.
-    pub fn width(&self) -> usize {
-        self.isa.width()
     }
 
     pub fn node_count(&self) -> usize {
@@ -163,7 +151,8 @@ impl Accel {
         {
             use super::simd::avx::{Avx2, Avx512, AvxLevel};
             match self.bvh {
-                // SAFETY: an accel of these ISAs is only built where the CPU supports them (`from_binary`).
+                // SAFETY: an accel of these ISAs is only built where the CPU supports them (the
+                // assertion in `Accel::collapse`).
                 IsaBvh::Avx512(_) => return unsafe { Avx512::run(f) },
                 // SAFETY: as above.
                 IsaBvh::Avx2(_) => return unsafe { Avx2::run(f) },
@@ -181,7 +170,8 @@ impl Accel {
         {
             use super::simd::avx::{Avx2, AvxLevel};
             if let IsaBvh::Avx512(_) | IsaBvh::Avx2(_) = self.bvh {
-                // SAFETY: an accel of these ISAs is only built where the CPU supports AVX2 (`from_binary`).
+                // SAFETY: an accel of these ISAs is only built where the CPU supports them, AVX2
+                // included (the assertion in `Accel::collapse`).
                 return unsafe { Avx2::run(f) };
             }
         }

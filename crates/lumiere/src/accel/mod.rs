@@ -40,6 +40,16 @@ pub struct Hit {
     pub v: f32,
 }
 
+impl Hit {
+    /// Whether a hit at `t` on `triangle` wins over one at `best_t` on `best_triangle`: the
+    /// closer, ties to the lower id. Every traversal keeps hits by this one rule, so that the
+    /// order triangles are tested in never changes the answer.
+    #[inline(always)]
+    pub fn precedes(t: f32, triangle: u32, best_t: f32, best_triangle: u32) -> bool {
+        t < best_t || (t == best_t && triangle < best_triangle)
+    }
+}
+
 /// Work done by counted queries, for the benchmarks: interior nodes whose children were box-tested
 /// and triangle blocks tested.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -22,7 +22,7 @@ use super::{Bvh, Node};
 use crate::geometry::triangle::is_degenerate;
 use crate::math::Aabb;
 
-/// Leaves never hold more triangles than this (the traversal's leaf loop is sized by it).
+/// Leaves never hold more triangles than this (the wide leaf references' count bits are sized by it).
 pub const MAX_LEAF_SIZE: usize = 16;
 /// Below this depth splits follow the SAH; deeper, the build halves by object count, so the
 /// depth, and the traversal stack, stay bounded whatever the input.
@@ -61,14 +61,6 @@ impl BuildPreset {
         match self {
             BuildPreset::Fast => 0.0,
             BuildPreset::Default | BuildPreset::HighQuality => spatial_split::REFERENCE_BUDGET,
-        }
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            BuildPreset::Fast => "fast",
-            BuildPreset::Default => "default",
-            BuildPreset::HighQuality => "high",
         }
     }
 }

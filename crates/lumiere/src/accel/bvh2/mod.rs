@@ -35,8 +35,8 @@ pub struct Bvh {
 }
 
 impl Bvh {
-    /// Builds over the triangles `indices` of `positions` for the layout rendered today, [`Bvh4`]:
-    /// the SAH counts leaves in its blocks of four triangles. Triangle ids in hits are positions in
+    /// Builds over the triangles `indices` of `positions` for the 4-wide layout, [`Bvh4`] (SSE2
+    /// and the portable kernel): the SAH counts leaves in its blocks of four triangles. Triangle ids in hits are positions in
     /// `indices`. Zero-area triangles are left out: they are never hit.
     pub fn build(positions: &[Vec3], indices: &[[u32; 3]], preset: BuildPreset) -> Bvh {
         Self::build_for_width::<{ Bvh4::WIDTH }>(positions, indices, preset)

@@ -55,7 +55,7 @@ impl Bvh {
                     let [p0, p1, p2] = self.vertices[slot];
                     if let Some(h) = intersect_triangle(&tri_ray, tmax, p0, p1, p2) {
                         let id = self.triangle_ids[slot];
-                        if best.is_none_or(|b| h.t < b.t || (h.t == b.t && id < b.triangle)) {
+                        if best.is_none_or(|b| Hit::precedes(h.t, id, b.t, b.triangle)) {
                             best = Some(Hit { t: h.t, triangle: id, u: h.u, v: h.v });
                             tmax = h.t;
                         }

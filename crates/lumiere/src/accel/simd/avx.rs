@@ -7,9 +7,10 @@
 //! AVX-512 level runs the 16-lane loops of `Accel::simd`.
 //!
 //! Unlike SSE, neither is part of the x86-64 baseline: these intrinsics may only run on a CPU that
-//! has the level's features. The kernel's operations run only through [`Lanes::dispatch`] on a
-//! [`crate::accel::WideBvh`] built for it, which `Accel::build` creates only when
-//! [`Lanes::supported`] holds. `dispatch` also enters the one `#[target_feature]` function the
+//! has the level's features. The kernel's operations run only on a [`crate::accel::WideBvh`] built
+//! for it, which `WideBvh::from_tree` creates only when [`Lanes::supported`] holds (and `Accel`
+//! only when its ISA is supported): through [`Lanes::dispatch`], or inlined into a caller that
+//! runs in `Accel::simd` already. `dispatch` also enters the one `#[target_feature]` function the
 //! kernel code is inlined into, so that each intrinsic below compiles to one instruction there.
 
 use std::arch::x86_64::*;

@@ -4,9 +4,10 @@
 //! The wide traversal and the batches are written once against [`Lanes`]; a kernel is a type
 //! implementing it for one width:
 //! - [`sse::F32x4`]: four lanes, SSE, part of the x86-64 baseline, so it needs no detection;
-//! - `avx::F32x8<Avx2>` and `avx::F32x8<Avx512>`: eight lanes, entered through
-//!   [`Lanes::dispatch`], which runs the traversal inside a `#[target_feature]` function; they exist
-//!   only inside an [`crate::accel::Accel`] built after checking [`Lanes::supported`];
+//! - `avx::F32x8<Avx2>`: eight lanes, entered through [`Lanes::dispatch`], which runs the
+//!   traversal inside a `#[target_feature]` function; it exists only inside an
+//!   [`crate::accel::Accel`] built after checking [`Isa::is_supported`] (both AVX ISAs walk the tree
+//!   with it; the AVX-512 level compiles the lane loops of `Accel::simd`);
 //! - [`portable::F32xN`]: plain arrays of any width, the fallback on other architectures and a
 //!   second implementation the tests check the others against.
 //!
@@ -14,7 +15,7 @@
 //! triangle test must round exactly like the scalar one, so every ISA gives the same image bytes.
 
 #[cfg(target_arch = "x86_64")]
-pub(crate) mod avx;
+pub(in crate::accel) mod avx;
 mod isa;
 pub mod portable;
 #[cfg(target_arch = "x86_64")]
@@ -49,7 +50,8 @@ pub trait Lanes<const W: usize>:
     }
 
     /// Runs `f`, the traversal written against this kernel, with the kernel's instruction set
-    /// enabled. Every entry point of the wide BVH goes through it.
+    /// enabled. Every entry point of the wide BVH goes through it, except the walks inlined into
+    /// a caller that runs in `Accel::simd` already (`WideBvh::occluded_from_origin`).
     #[inline(always)]
     fn dispatch<R>(f: impl FnOnce() -> R) -> R {
         f()

@@ -4,8 +4,8 @@
 //!
 //! The layout (nodes, blocks, collapse, leaf references) is generic in the width `W`; the traversal
 //! is generic over the lane kernel `L` (see `simd/`). [`crate::accel::Accel`] instantiates `W = 4`
-//! with the SSE kernel (the x86-64 baseline) or the portable one, and `W = 8` with the AVX2 and
-//! AVX-512 kernels.
+//! with the SSE kernel (the x86-64 baseline) or the portable one, and `W = 8` with the AVX2 kernel
+//! (on both AVX ISAs: see `Accel`).
 
 mod collapse;
 mod collapse_plan;
@@ -23,6 +23,7 @@ use glam::Vec3;
 pub(super) use leaf::{LEAF_BIT, blocks as leaf_blocks};
 pub use node::{TriangleBlock, WideNode};
 pub use packet::{PacketKey, RayPacket};
+pub(super) use traverse::Stack;
 
 use super::bvh2::{BuildPreset, Bvh};
 

@@ -30,7 +30,7 @@ pub struct TriangleBlock<const W: usize> {
 }
 
 impl<const W: usize> WideNode<W> {
-    /// Evaluated (at compile time) for each width the program instantiates, by `WideBvh::from_binary`.
+    /// Evaluated (at compile time) for each width the program instantiates, by `WideBvh::from_tree`.
     pub(super) const BYTE_BUDGET: () = assert!(size_of::<Self>() == 32 * W, "a wide node is 32 bytes per child");
 
     /// No children: every box NaN, every slot empty.
@@ -88,12 +88,20 @@ impl<const W: usize> WideNode<W> {
 }
 
 impl<const W: usize> TriangleBlock<W> {
-    /// Evaluated (at compile time) for each width the program instantiates, by `WideBvh::from_binary`.
+    /// Whether triangle `lane` is padding: the repeat of its predecessor that fills a leaf's last
+    /// block (a duplicate never changes an answer, but need not be tested twice).
+    #[inline(always)]
+    pub(in crate::accel) fn is_padding(&self, lane: usize) -> bool {
+        lane > 0 && self.ids[lane] == self.ids[lane - 1]
+    }
+
+    /// Evaluated (at compile time) for each width the program instantiates, by `WideBvh::from_tree`.
     pub(super) const BYTE_BUDGET: () =
         assert!(size_of::<Self>() == 40 * W, "a triangle block is 40 bytes per triangle");
 }
 
-// The width rendered today, spelled out: 128-byte nodes (two cache lines), 160-byte blocks.
+// Width 4 (SSE2 and the portable kernel), spelled out: 128-byte nodes (two cache lines), 160-byte
+// blocks.
 const _: () = assert!(size_of::<WideNode<4>>() == 128);
 const _: () = assert!(size_of::<TriangleBlock<4>>() == 160);
 
@@ -108,7 +116,7 @@ mod tests {
 
     /// Children whose boxes lie along x in the slot order `positions`, some slots empty: rays going
     /// +x meet them from least to greatest x, rays going -x the other way; empty slots come last;
-    /// every octant's order holds every slot once (at both widths stored: 4 and 8 bits an octant).
+    /// every octant's order holds every slot once (at both widths stored: 4 and 8 slots, 16 and 32 bits an octant).
     fn check_orders<const W: usize>(positions: [Option<f32>; W]) {
         let mut node = WideNode::<W>::empty();
         for (slot, x) in positions.iter().enumerate() {

@@ -375,7 +375,7 @@ impl<const N: usize> Closest<N> {
     /// Keeps the hit of lane `lane` if it is closer, or as close with a lower id (the single-ray rule).
     #[inline(always)]
     fn offer(&mut self, lane: usize, t: f32, triangle: u32, u: f32, v: f32) {
-        if t < self.t[lane] || (t == self.t[lane] && triangle < self.triangle[lane]) {
+        if Hit::precedes(t, triangle, self.t[lane], self.triangle[lane]) {
             (self.t[lane], self.triangle[lane], self.u[lane], self.v[lane]) = (t, triangle, u, v);
         }
     }
@@ -533,12 +533,6 @@ impl BoxFirst {
     }
 }
 
-/// Whether triangle `lane` of a block is real, not the repeat of its predecessor that pads a leaf.
-#[inline(always)]
-fn is_padding<const W: usize>(block: &TriangleBlock<W>, lane: usize) -> bool {
-    lane > 0 && block.ids[lane] == block.ids[lane - 1]
-}
-
 // Inlined into the caller, which runs them in its ISA's `Accel::simd`: unlike the single-ray entry
 // points, these own no dispatch of their own.
 impl<const W: usize, L> WideBvh<W, L> {
@@ -568,7 +562,7 @@ impl<const W: usize, L> WideBvh<W, L> {
             }
             for block in &self.blocks[leaf::blocks::<W>(reference)] {
                 let outside = span.outside(packet, self.moderate_extent, block);
-                for lane_in_block in (0..W).filter(|&l| outside & (1 << l) == 0 && !is_padding(block, l)) {
+                for lane_in_block in (0..W).filter(|&l| outside & (1 << l) == 0 && !block.is_padding(l)) {
                     if use_boxes {
                         boxes_tested += 1;
                         if !packet.may_hit(block, lane_in_block, &limit) {
@@ -631,7 +625,7 @@ impl<const W: usize, L> WideBvh<W, L> {
             }
             for block in &self.blocks[leaf::blocks::<W>(reference)] {
                 let outside = span.outside(packet, self.moderate_extent, block);
-                for lane_in_block in (0..W).filter(|&l| outside & (1 << l) == 0 && !is_padding(block, l)) {
+                for lane_in_block in (0..W).filter(|&l| outside & (1 << l) == 0 && !block.is_padding(l)) {
                     if use_boxes {
                         boxes_tested += 1;
                         if !packet.may_hit(block, lane_in_block, &limit) {

@@ -21,21 +21,21 @@ use crate::math::Ray;
 /// and pops the first to visit right after, so `(W - 1) * MAX_DEPTH + W` entries would do (writes
 /// included: [`Stack::push_if`] writes the entry it drops too); stable Rust cannot size an array by
 /// an expression of a const parameter, so the stack holds one row of `W` entries per level. An
-/// entry is a node reference with its entry distance, or with the lanes that entered it
-/// (`shared_origin.rs`).
-pub(super) struct Stack<const W: usize, T: Copy = (u32, f32)> {
+/// entry is a node reference with its entry distance, with the lanes that entered it
+/// (`shared_origin.rs`), or alone (the batches' walk of a region, `batch.rs`).
+pub(in crate::accel) struct Stack<const W: usize, T: Copy = (u32, f32)> {
     entries: [[MaybeUninit<T>; W]; MAX_DEPTH + 1],
     len: usize,
 }
 
 impl<const W: usize, T: Copy> Stack<W, T> {
     #[inline(always)]
-    pub(super) fn new() -> Self {
+    pub(in crate::accel) fn new() -> Self {
         Stack { entries: [[MaybeUninit::uninit(); W]; MAX_DEPTH + 1], len: 0 }
     }
 
     #[inline(always)]
-    pub(super) fn push(&mut self, entry: T) {
+    pub(in crate::accel) fn push(&mut self, entry: T) {
         // The build bounds the depth by MAX_DEPTH and each level pushes at most W - 1 entries.
         self.entries.as_flattened_mut()[self.len] = MaybeUninit::new(entry);
         self.len += 1;
@@ -51,7 +51,7 @@ impl<const W: usize, T: Copy> Stack<W, T> {
     }
 
     #[inline(always)]
-    pub(super) fn pop(&mut self) -> Option<T> {
+    pub(in crate::accel) fn pop(&mut self) -> Option<T> {
         self.len = self.len.checked_sub(1)?;
         // SAFETY: entries below `len` were written by `push` before `len` grew past them.
         Some(unsafe { self.entries.as_flattened()[self.len].assume_init() })
@@ -261,8 +261,9 @@ impl<const W: usize, L: Lanes<W>> WideBvh<W, L> {
     }
 
     /// Whether the ray (`box_ray`, `tri_ray`, `tmax`) is blocked by a triangle under the node or
-    /// leaf `start` (0: the root) that `keep` accepts, visiting the children it enters in `order`
-    /// of their entry distance (the answer is the same either way).
+    /// leaf `start` (0: the root) that `keep` accepts, visiting the children it enters nearest or
+    /// farthest first (`order`) by the node's stored order for the ray's octant (the answer is
+    /// the same either way).
     #[inline(always)]
     #[expect(clippy::too_many_arguments, reason = "the ray in its three forms and four settings of the walk")]
     pub(super) fn occluded_below<const COUNT: bool>(
@@ -329,7 +330,7 @@ fn closest_in_block<const W: usize, L: Lanes<W>>(
     let hits = intersect_block(tri_ray, block, *tmax);
     for lane in lanes_of(hits.mask) {
         let (t, id, u, v) = (hits.t[lane], block.ids[lane], hits.u[lane], hits.v[lane]);
-        if best.is_none_or(|b| t < b.t || (t == b.t && id < b.triangle)) && keep(id, u, v) {
+        if best.is_none_or(|b| Hit::precedes(t, id, b.t, b.triangle)) && keep(id, u, v) {
             *best = Some(Hit { t, triangle: id, u, v });
             *tmax = t;
         }
