@@ -87,8 +87,14 @@ impl World {
         let kinds = scene.materials.iter().map(Material::kind).collect();
         let (texture_of_material, textures, mut warnings) =
             TextureSet::for_materials(scene.materials.iter().map(|m| m.map_kd.as_deref()));
+        // Lights are sampled over their whole triangles, so an emitter stays whole for the rays
+        // that find it too: cut out, a BSDF-sampled ray would pass where light sampling adds
+        // emission, and the two strategies would disagree.
+        for emitter in scene.materials.iter().filter(|m| m.is_emissive() && m.map_d.is_some()) {
+            warnings.push(format!("material '{}': map_d is ignored on an emitter; it stays opaque", emitter.name));
+        }
         let (cutout_of_material, cutouts, cutout_warnings) =
-            TextureSet::for_cutouts(scene.materials.iter().map(|m| m.map_d.as_deref()));
+            TextureSet::for_cutouts(scene.materials.iter().map(|m| m.map_d.as_deref().filter(|_| !m.is_emissive())));
         warnings.extend(cutout_warnings);
         let diameter = scene.bounds().extent().length();
         let prefetches = scene.mesh.memory_bytes() + textures.memory_bytes() > PREFETCH_ABOVE_BYTES;
@@ -213,12 +219,6 @@ impl World {
     /// The instruction set the BVH was built for.
     pub fn isa(&self) -> Isa {
         self.accel.isa()
-    }
-
-    /// The material of triangle `id`.
-    #[inline]
-    pub fn material(&self, id: u32) -> &Material {
-        self.scene.material(id)
     }
 
     /// Radiance emitted by triangle `id` along `ray` back towards its origin: the emission of a

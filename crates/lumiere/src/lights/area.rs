@@ -51,6 +51,18 @@ impl AreaLight {
     pub fn power(&self) -> Vec3 {
         std::f32::consts::PI * self.area * self.emission
     }
+
+    /// The light's weight in the power-proportional choice: its flux summed over the channels,
+    /// the `f32` sum exactly, or, where that overflows (a huge but finite `Ke`), the same sum in
+    /// `f64`, so that one bright light cannot leave the whole scene without a choice.
+    pub fn power_weight(&self) -> f64 {
+        let sum = self.power().element_sum();
+        if sum.is_finite() {
+            return f64::from(sum);
+        }
+        let [r, g, b] = self.emission.to_array().map(f64::from);
+        std::f64::consts::PI * f64::from(self.area) * (r + g + b)
+    }
 }
 
 /// Every emissive triangle of a scene, in triangle id order. Zero-area triangles are skipped: they
@@ -68,7 +80,15 @@ pub(super) fn collect_lights(scene: &Scene) -> Vec<AreaLight> {
             let area = triangle_area(p0, p1, p2);
             let normal = triangle_normal(p0, p1, p2).try_normalize()?;
             let shadow_targets = vertices.map(|v| offset_ray_origin(v, normal));
-            (area > 0.0).then_some(AreaLight { triangle: id as u32, vertices, shadow_targets, normal, area, emission })
+            // An area that overflows (corners near f32's limits) could not be sampled.
+            (area > 0.0 && area.is_finite()).then_some(AreaLight {
+                triangle: id as u32,
+                vertices,
+                shadow_targets,
+                normal,
+                area,
+                emission,
+            })
         })
         .collect()
 }

@@ -3,7 +3,9 @@
 //!
 //! Samples carry their pdf per unit solid angle at the receiver, the measure in which BSDF samples
 //! are drawn too, so that multiple importance sampling compares like with like. The conversion from
-//! the area measure happens here and nowhere else.
+//! the area measure happens here, and in the lane loops that repeat `sample_li_on`'s operations
+//! for many samples at once (`integrators/direct.rs`, `integrators/path/diffuse.rs`), which must
+//! stay in step with it (their tests compare bits).
 
 mod area;
 mod quad;
@@ -37,8 +39,6 @@ pub struct LightSample {
     pub li: Vec3,
     /// Unit direction from `p` to the light point.
     pub wi: Vec3,
-    /// Distance from `p` to the light point.
-    pub dist: f32,
     /// Probability density of this point per unit solid angle at `p`, light choice included.
     pub pdf: f32,
     /// Where a shadow segment from `p` ends: the sampled point moved a few ulps to the emitting side
@@ -73,7 +73,7 @@ impl LightSet {
         for (index, light) in lights.iter().enumerate() {
             light_of_triangle[light.triangle as usize] = index as u32;
         }
-        let weights: Vec<f32> = lights.iter().map(|l| l.power().element_sum()).collect();
+        let weights: Vec<f64> = lights.iter().map(AreaLight::power_weight).collect();
         LightSet { lights, light_of_triangle, power: AliasTable::new(&weights), quads: OnceLock::new() }
     }
 
@@ -188,7 +188,7 @@ impl LightSet {
         }
         // Area measure 1/A to solid angle: dA = dω d² / cos θ_light, with cos θ_light = -n·v / d.
         let pdf = dist2 * dist / (cos_light_dist * light.area);
-        Some(LightSample { li: light.emission, wi, dist, pdf, target, light: index })
+        Some(LightSample { li: light.emission, wi, pdf, target, light: index })
     }
 
     /// The solid-angle pdf with which [`LightSet::sample_li`] would have produced the point of light

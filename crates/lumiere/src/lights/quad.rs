@@ -15,8 +15,6 @@ use super::AreaLight;
 /// The shadow targets of a pair of light triangles as one convex quad.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct QuadLight {
-    /// The pair, as indices into the light list.
-    pub lights: [u32; 2],
     /// The corners in order around the quad (the first triangle's unshared corner, a shared one,
     /// the second triangle's unshared corner, the other shared one).
     pub corners: [Vec3; 4],
@@ -116,5 +114,5 @@ fn quad_of(lights: &[AreaLight], first: u32, second: u32, edge: usize) -> Option
     let n = l1.normal;
     let w = -n.dot(l1.shadow_targets[0]);
     let lowest = l1.shadow_targets.iter().chain(&l2.shadow_targets).map(|t| n.dot(*t) + w).fold(0.0f32, f32::min);
-    Some(QuadLight { lights: [first, second], corners, plane: n.extend(w - 2.0 * lowest) })
+    Some(QuadLight { corners, plane: n.extend(w - 2.0 * lowest) })
 }

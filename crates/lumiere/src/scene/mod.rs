@@ -61,6 +61,13 @@ impl Scene {
         if let Some(bad) = mesh.indices.iter().flatten().find(|&&i| i as usize >= mesh.positions.len()) {
             return Err(Error::invalid(format!("{name}: vertex index {bad} out of range")));
         }
+        // The loaders check this already; scenes made from arrays (Python) are checked here.
+        if let Some(bad) = materials.iter().find(|m| !(m.ke.is_finite() && m.ke.min_element() >= 0.0)) {
+            return Err(Error::invalid(format!(
+                "{name}: material '{}': emission {} {} {} must be finite and not negative",
+                bad.name, bad.ke.x, bad.ke.y, bad.ke.z
+            )));
+        }
         Ok(Scene { name, mesh, materials, warnings, sources: Vec::new() })
     }
 

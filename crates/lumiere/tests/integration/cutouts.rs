@@ -80,12 +80,16 @@ fn techniques() -> Vec<(Technique, u32)> {
 fn images(scene: &Scene, isa: Isa) -> Vec<Vec<Vec3>> {
     let world = World::with_isa(scene.clone(), BuildPreset::Default, isa);
     assert!(world.warnings().is_empty(), "{:?}", world.warnings());
+    images_of(&world)
+}
+
+fn images_of(world: &World) -> Vec<Vec<Vec3>> {
     let camera = Camera::look_at(Vec3::new(0.3, 3.0, 2.5), Vec3::ZERO, Vec3::Y, 55.0, 40, 30).unwrap();
     techniques()
         .into_iter()
         .map(|(technique, spp)| {
             let options = RenderOptions { spp, seed: 3, ..RenderOptions::new(technique) };
-            render(&world, &camera, &options, &|_| {}).unwrap().image.pixels
+            render(world, &camera, &options, &|_| {}).unwrap().image.pixels
         })
         .collect()
 }
@@ -119,6 +123,24 @@ fn a_clear_mask_renders_the_bytes_of_no_blocker_on_every_isa() {
         // comparison above can fail.
         let differ = images(&with, isa).iter().zip(&expected).filter(|(a, b)| a != b).count();
         assert_eq!(differ, techniques().len() - 2, "{isa}: the blocker is invisible");
+    }
+}
+
+#[test]
+fn an_emitter_ignores_its_mask_with_a_warning() {
+    // Lights are sampled over whole triangles; a ray must find the whole triangle too, or light
+    // sampling and BSDF sampling would disagree about where the light is.
+    let dir = TempDir::new("cutout-emitter");
+    let mut masked = scene(None, false);
+    masked.materials[1].map_d = Some(grey_mask(&dir, "black.png", &[0, 0]));
+    let plain = scene(None, false);
+    for isa in Isa::supported() {
+        let world = World::with_isa(masked.clone(), BuildPreset::Default, isa);
+        assert_eq!(world.warnings(), ["material 'light': map_d is ignored on an emitter; it stays opaque"]);
+        let got = images_of(&world);
+        for (k, (g, e)) in got.iter().zip(&images(&plain, isa)).enumerate() {
+            assert!(g == e, "{isa}: technique {:?} differs with a clear mask on the light", techniques()[k].0);
+        }
     }
 }
 

@@ -114,6 +114,31 @@ fn the_triangle_to_light_map_names_each_emitter() {
     );
 }
 
+#[test]
+fn a_light_whose_power_overflows_f32_leaves_the_others_choosable() {
+    // Ke 1e38 on the dim light: pi * area * Ke summed over three channels overflows f32; its
+    // weight is taken in f64, and power choice still works (it picks the huge light almost always).
+    let mut scene = light_scene();
+    scene.materials[1].ke = Vec3::splat(1e38);
+    let lights = LightSet::new(&scene);
+    let (index, pmf) = lights.choose(LightSelection::Power, 0.75).expect("power choice is available");
+    assert_eq!(index, 0);
+    assert!(pmf > 0.99 && pmf <= 1.0, "{pmf}");
+    assert!(lights.choice_pmf(LightSelection::Power, 1) > 0.0);
+}
+
+#[test]
+fn emission_that_is_negative_or_not_finite_is_refused() {
+    for ke in [Vec3::new(1.0, -1.0, 1.0), Vec3::new(f32::NAN, 1.0, 1.0), Vec3::splat(f32::INFINITY)] {
+        let scene = light_scene();
+        let mut materials = scene.materials.clone();
+        materials[2].ke = ke;
+        let error = Scene::from_parts("lights".into(), scene.mesh.clone(), materials, vec![]).unwrap_err();
+        let message = error.to_string();
+        assert!(message.contains("material 'bright'") && message.contains("not negative"), "{message}");
+    }
+}
+
 /// Light choice by power and uniformly: observed frequencies match `choice_pmf`.
 #[test]
 fn light_choice_frequencies_match_their_pmf() {

@@ -179,11 +179,12 @@ impl<const N: usize> DiffuseVertices<N> {
             let mut throughput = throughput * (f * (local.z.abs() / pdf));
             let q = throughput.max_element().min(0.95);
             let roulette = self.roulette >> lane & 1 != 0;
-            let survives = !roulette || !(q.is_nan() || self.survival[lane] >= q);
+            let finite = throughput.is_finite();
+            let survives = !roulette || self.survival[lane] < q;
             if roulette {
                 throughput /= q;
             }
-            continues |= u32::from(scattered && sides_agree(wi, local) && survives) << lane;
+            continues |= u32::from(scattered && sides_agree(wi, local) && finite && survives) << lane;
             set_row(&mut origins, lane, surface.spawn_ray(wi).origin);
             set_row(&mut wis, lane, wi);
             set_row(&mut throughputs, lane, throughput);

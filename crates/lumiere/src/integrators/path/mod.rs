@@ -299,6 +299,7 @@ impl Path {
     ///
     /// Out of line: inlined into `trace`'s loop, the Cornell box took 4% longer (its BSDF sampling
     /// and sampler calls were laid out worse).
+    #[inline(never)]
     fn scatter(
         &self,
         world: &World,
@@ -341,6 +342,11 @@ impl Path {
             return (false, shadow);
         }
         path.throughput *= scattered.f * (scattered.wi.z.abs() / scattered.pdf);
+        // A weight gone infinite or NaN (a pdf underflowing to 0) could only spoil the pixel's
+        // sample, which the film would then discard: end the path with what it has found.
+        if !path.throughput.is_finite() {
+            return (false, shadow);
+        }
         let specular = scattered.flags.contains(BsdfFlags::SPECULAR);
         path.previous_pdf = if specular { f32::INFINITY } else { scattered.pdf };
         path.ray = surface.spawn_ray(wi);
@@ -348,7 +354,7 @@ impl Path {
         // Russian roulette, after `rr_depth` segments: survive with probability q, weigh by 1/q.
         if path.depth >= self.rr_depth {
             let q = path.throughput.max_element().min(0.95);
-            if q.is_nan() || numbers.survival >= q {
+            if numbers.survival >= q {
                 return (false, shadow);
             }
             path.throughput /= q;
