@@ -29,7 +29,6 @@ pub enum SamplerKind {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Sampler {
     pub kind: SamplerKind,
-    pub seed: u64,
     /// The hash of the seed that every number of this sampler starts from, computed once here
     /// rather than once per number.
     key: u64,
@@ -42,7 +41,7 @@ impl Sampler {
             SamplerKind::Independent => 0x5EED_1DE9_E4DE_4E47,
             SamplerKind::Sobol => 0x50B0_15C4_A3B1_ED00,
         };
-        Sampler { kind, seed, key: mix64(seed ^ salt) }
+        Sampler { kind, key: mix64(seed ^ salt) }
     }
 
     /// One uniform number in `[0, 1)`.
@@ -242,7 +241,8 @@ impl PointSet<'_> {
 
     /// Points `first .. first + N` of the set: exactly the numbers of [`PointSet::get_2d`], with
     /// the sampler's kind and Sobol's per-dimension seeds decided once instead of per point, in
-    /// loops the compiler can vectorise (for the ray-major batches, which draw 16 points at once).
+    /// loops the compiler can vectorise (for the ray-major batches, which draw 32 or 16 points at
+    /// once: `WIDE_GROUP`, `NARROW_GROUP`).
     #[inline(always)]
     pub fn get_2d_lanes<const N: usize>(&self, first: u32) -> [Vec2; N] {
         let sampler = self.sampler;

@@ -10,7 +10,8 @@ pub struct SurfacePoint {
     /// Position, interpolated from the vertices (more accurate than `origin + t * dir`).
     pub p: Vec3,
     /// Unit geometric normal, turned towards the side the ray came from. Decides which side a ray
-    /// leaves on; never used for shading.
+    /// leaves on and whether a direction is on the side the shading normal says (no light leaks
+    /// where the two disagree); ambient occlusion's hemisphere is built on it.
     pub ng: Vec3,
     /// Unit shading normal (interpolated vertex normals when the file has them, else `ng`), on
     /// `ng`'s side.

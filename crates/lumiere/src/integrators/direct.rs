@@ -295,6 +295,10 @@ impl ShadesClosestHit for Direct {
                 let mut batch = std::mem::take(&mut ctx.batch);
                 let mut batch_quad = None;
                 for (index, light) in lights.lights().iter().enumerate() {
+                    // Each light's samples poll too, but only from `STOP_POLL` of them on.
+                    if ctx.must_stop(index as u32) {
+                        break;
+                    }
                     // Taken for every light, lit or not, so that each light keeps its dimension.
                     let points = ctx.stream.next_points(n);
                     if !faces_each_other(surface, light) {

@@ -89,7 +89,8 @@ pub struct SampleContext<'a> {
     pub batch: OriginBatch,
     pub rays: u64,
     /// True once the render must stop (Ctrl-C, time budget). Integrators whose pixels can take
-    /// long (thousands of samples or lights) poll it every [`STOP_POLL`] samples and return early;
+    /// long (thousands of samples or lights) poll it every [`STOP_POLL`] samples or lights
+    /// ([`SampleContext::must_stop`]) and return early;
     /// the pass is then abandoned, so the value they return is never used.
     pub stop: &'a (dyn Fn() -> bool + Sync),
 }
@@ -99,7 +100,8 @@ pub struct SampleContext<'a> {
 pub const STOP_POLL: u32 = 1024;
 
 impl SampleContext<'_> {
-    /// Whether the render must stop, polled at sample `k` of a long loop (every `STOP_POLL`).
+    /// Whether the render must stop, polled at sample (or light) `k` of a long loop (every
+    /// `STOP_POLL`).
     #[inline]
     pub fn must_stop(&self, k: u32) -> bool {
         k % STOP_POLL == STOP_POLL - 1 && (self.stop)()

@@ -27,6 +27,10 @@ impl Integrator for Shadows {
         };
         let mut sum = Vec3::ZERO;
         for (index, light) in world.lights().lights().iter().enumerate() {
+            // Thousands of lights make a long pixel (the staircase's bulbs: 6,430).
+            if ctx.must_stop(index as u32) {
+                break;
+            }
             let point = LightPoint::of(world, index, light);
             if let Some((segment, contribution)) = receiver.unshadowed(light, &point) {
                 ctx.rays += 1;
@@ -83,6 +87,9 @@ impl Integrator for Shadows {
         let mut segments = camera.rays;
         let mut contributions = [Vec3::ZERO; PACKET];
         for (index, light) in world.lights().lights().iter().enumerate() {
+            if ctx.must_stop(index as u32) {
+                break;
+            }
             let point = LightPoint::of(world, index, light);
             // In the ISA's width: the lane loop's square roots and divisions, 16 at a time.
             let mut traced = world.simd(

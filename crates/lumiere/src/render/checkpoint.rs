@@ -142,8 +142,12 @@ impl Reader<'_> {
     }
 }
 
+/// The longest option value a refused resume quotes.
+const QUOTED_VALUE_CHARS: usize = 120;
+
 /// The lines of two option descriptions that differ, as `key (checkpoint: …; now: …)`, in the
-/// order of the current description.
+/// order of the current description; a value too long to read in a one-line message (the
+/// camera's matrices) is only said to differ.
 pub fn differing_options(saved: &str, now: &str) -> Vec<String> {
     let parse = |text: &str| -> Vec<(String, String)> {
         text.lines().filter_map(|l| l.split_once(": ")).map(|(k, v)| (k.to_string(), v.to_string())).collect()
@@ -157,7 +161,13 @@ pub fn differing_options(saved: &str, now: &str) -> Vec<String> {
     keys.into_iter()
         .filter_map(|key| {
             let (a, b) = (value(&saved, key), value(&now, key));
-            (a != b).then(|| format!("{key} (checkpoint: {a}; now: {b})"))
+            (a != b).then(|| {
+                if a.len().max(b.len()) > QUOTED_VALUE_CHARS {
+                    format!("{key} (differs from the checkpoint's)")
+                } else {
+                    format!("{key} (checkpoint: {a}; now: {b})")
+                }
+            })
         })
         .collect()
 }

@@ -43,9 +43,11 @@ pub fn scene_fingerprint(scene: &Scene) -> u64 {
 pub fn options_description(options: &RenderOptions, camera: &Camera) -> String {
     // Debug output of these plain records is exact (floats print in shortest round-trip form).
     let pixels = if options.samples_pixel_centres() { "centres (--spp 1)" } else { "jittered (--spp above 1)" };
+    // The image size has a line of its own, so that a refusal can name it readably: the camera's
+    // line (its matrices) is too long to quote (see `differing_options`).
     format!(
-        "technique: {:?}\nseed: {}\nsampler: {:?}\npixel positions: {pixels}\ncamera: {camera:?}\n",
-        options.technique, options.seed, options.sampler
+        "technique: {:?}\nseed: {}\nsampler: {:?}\npixel positions: {pixels}\nimage size: {}x{}\ncamera: {camera:?}\n",
+        options.technique, options.seed, options.sampler, camera.width, camera.height
     )
 }
 

@@ -147,7 +147,7 @@ fn run_passes<I: Integrator>(
     // film (no copy), and every later pass reuses a second one.
     let mut buffer = Vec::new();
     let expired = AtomicBool::new(false);
-    // Checked between passes, before every pixel and inside costly pixels, so that a render of
+    // Checked between passes, before every 4x4 block of pixels and inside costly pixels, so that a render of
     // thousands of samples or lights per pixel neither outlives its budget nor ignores Ctrl-C. Two
     // atomic loads: reading the clock per pixel would cost more than a hard-shadow pixel.
     let stop_now = || {

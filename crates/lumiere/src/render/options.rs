@@ -16,7 +16,8 @@ pub struct RenderOptions {
     pub spp: u32,
     pub seed: u64,
     pub sampler: SamplerKind,
-    /// Stop after the pass that crosses this much rendering time.
+    /// Stop once this run has rendered this long (a resumed render gets the whole budget again),
+    /// abandoning the pass in flight: the film keeps completed passes only.
     pub time_budget: Option<Duration>,
     /// Stop once the image's estimated relative standard error is below this.
     pub noise_target: Option<f64>,
