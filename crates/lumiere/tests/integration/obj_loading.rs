@@ -194,9 +194,17 @@ fn mtl_statements_and_texture_paths() {
     dir.write("materials/glass.mtl", mtl.as_bytes());
     let obj = dir.write("scene.obj", format!("mtllib materials/glass.mtl\n{SQUARE}usemtl glass\nf 1 2 3\n").as_bytes());
     let scene = load_obj(&obj).expect("load");
-    // The bump map is not rendered: one warning names it; the ambient `Ka` passes silently.
-    assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
-    assert!(scene.warnings[0].contains("material \"glass\" uses statements lumiere does not render: \"map_Bump\""));
+    // The bump map and the texture's options are not rendered: one warning names them; the
+    // ambient `Ka` passes silently. "ghostly"'s `d 0.5` without `Ni` is not glass: coverage, which
+    // only map_d gives.
+    assert_eq!(scene.warnings.len(), 2, "{:?}", scene.warnings);
+    assert!(
+        scene.warnings[0]
+            .contains("material \"glass\" uses statements lumiere does not render: \"map_Kd -bm -o\", \"map_Bump\""),
+        "{:?}",
+        scene.warnings
+    );
+    assert!(scene.warnings[1].contains("material \"ghostly\" uses statements lumiere does not render: \"d\" below 1"));
     let glass = &scene.materials[0];
     assert_eq!(glass.name, "glass");
     assert_eq!((glass.kd, glass.ks, glass.ke), (Vec3::new(0.1, 0.2, 0.3), Vec3::splat(0.5), Vec3::new(1.0, 2.0, 3.0)));
@@ -204,6 +212,30 @@ fn mtl_statements_and_texture_paths() {
     assert_eq!(glass.map_kd.as_deref(), Some(dir.0.join("materials/tex/wood.png").as_path()));
     assert!(scene.materials[1].map_kd.is_none());
     assert_eq!(scene.materials[1].dissolve, 0.5);
+}
+
+#[test]
+fn values_without_effect_are_named_in_the_material_warning() {
+    let mtl = "newmtl tinted\nKd 0.5 0.5 0.5\nTf 1 0 0\n\
+               newmtl veil\nd 0.5\n\
+               newmtl matte\nillum 10\n\
+               newmtl scaled\nmap_Kd -s 2 2 1 -clamp off wood.png\n\
+               newmtl fine\nillum 7\nTf 1 0 0\nd 0.5\nmap_d -clamp off leaf.png\n\
+               newmtl leaf\nd 0.5\nmap_d leaf.png\n";
+    let scene = parse_with(&format!("mtllib m.mtl\n{SQUARE}usemtl fine\nf 1 2 3\n"), &[("m.mtl", mtl)]);
+    let expected = [
+        ("tinted", "\"Tf\" (only glass filters light)"),
+        ("veil", "\"d\" below 1 without \"Ni\""),
+        ("matte", "\"illum 10\""),
+        ("scaled", "\"map_Kd -s\""),
+    ];
+    assert_eq!(scene.warnings.len(), expected.len(), "{:#?}", scene.warnings);
+    for ((name, what), warning) in expected.iter().zip(&scene.warnings) {
+        assert!(
+            warning.contains(&format!("material \"{name}\" uses statements lumiere does not render: {what}")),
+            "{warning}"
+        );
+    }
 }
 
 #[test]

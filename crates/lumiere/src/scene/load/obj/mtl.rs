@@ -3,7 +3,7 @@
 
 use super::text::{Tokens, finite_f32, lines, quoted};
 use crate::error::{quote, shown_path};
-use crate::materials::Material;
+use crate::materials::{Material, MaterialKind};
 use crate::scene::load::warnings::Warnings;
 use glam::Vec3;
 use std::path::{Path, PathBuf};
@@ -13,7 +13,8 @@ use std::path::{Path, PathBuf};
 pub(super) fn parse_mtl(bytes: &[u8], path: &Path, warnings: &mut Warnings) -> Vec<Material> {
     let folder = path.parent().unwrap_or(Path::new(""));
     let mut materials: Vec<Material> = Vec::new();
-    // Per material, the keywords of the statements it carries that lumiere does not render.
+    // Per material, what it carries that lumiere does not render: unknown statements' keywords
+    // (quoted) and texture options.
     let mut unsupported: Vec<Vec<String>> = Vec::new();
     for (i, line) in lines(bytes).enumerate() {
         let problem = match parse_statement(line, folder) {
@@ -24,14 +25,14 @@ pub(super) fn parse_mtl(bytes: &[u8], path: &Path, warnings: &mut Warnings) -> V
                 continue;
             }
             Ok(Some(Statement::Unsupported(keyword))) if !materials.is_empty() => {
-                let ignored = unsupported.last_mut().expect("one list per material");
-                if !ignored.contains(&keyword) {
-                    ignored.push(keyword);
-                }
+                note(&mut unsupported, quote(&keyword));
                 continue;
             }
             Ok(Some(statement)) => match materials.last_mut() {
                 Some(material) => {
+                    if let Some(option) = statement.texture_option() {
+                        note(&mut unsupported, option);
+                    }
                     statement.apply(material);
                     continue;
                 }
@@ -41,18 +42,47 @@ pub(super) fn parse_mtl(bytes: &[u8], path: &Path, warnings: &mut Warnings) -> V
         };
         warnings.push(path, "ignored MTL lines", || format!("{}:{}: {problem}; line ignored", shown_path(path), i + 1));
     }
-    for (material, ignored) in materials.iter().zip(&unsupported).filter(|(_, ignored)| !ignored.is_empty()) {
-        let keywords: Vec<String> = ignored.iter().map(quote).collect();
+    for (material, ignored) in materials.iter().zip(&mut unsupported) {
+        ignored.extend(unrendered_values(material));
+        if ignored.is_empty() {
+            continue;
+        }
         warnings.push(path, "unsupported MTL statements", || {
             format!(
                 "{}: material {} uses statements lumiere does not render: {} (see docs/MATERIALS.md)",
                 shown_path(path),
                 quote(&material.name),
-                keywords.join(", ")
+                ignored.join(", ")
             )
         });
     }
     materials
+}
+
+/// Adds `what` to the current material's list of what it does not get, once.
+fn note(unsupported: &mut [Vec<String>], what: String) {
+    let ignored = unsupported.last_mut().expect("one list per material");
+    if !ignored.contains(&what) {
+        ignored.push(what);
+    }
+}
+
+/// Statements lumiere reads but whose value, on this material, has no effect (docs/MATERIALS.md,
+/// "Not honoured"): a transmission filter on an opaque material, partial coverage without a
+/// texture, an illumination model beyond 9.
+fn unrendered_values(material: &Material) -> Vec<String> {
+    let glass = matches!(material.kind(), MaterialKind::Dielectric { .. });
+    let mut notes = Vec::new();
+    if !glass && material.tf != Vec3::ONE {
+        notes.push("\"Tf\" (only glass filters light)".to_string());
+    }
+    if !glass && material.dissolve < 1.0 && material.map_d.is_none() {
+        notes.push("\"d\" below 1 without \"Ni\" (partial coverage: use map_d for cutouts)".to_string());
+    }
+    if material.illum > 9 {
+        notes.push(quote(format!("illum {}", material.illum)));
+    }
+    notes
 }
 
 /// The MTL statements we keep; the others are named in one warning per material (`Ka` aside).
@@ -65,8 +95,8 @@ enum Statement {
     RefractiveIndex(f32),
     Dissolve(f32),
     Illumination(u32),
-    DiffuseMap(PathBuf),
-    CoverageMap(PathBuf),
+    DiffuseMap(TextureMap),
+    CoverageMap(TextureMap),
     TransmissionFilter(Vec3),
     Metallic(f32),
     Roughness(f32),
@@ -75,6 +105,18 @@ enum Statement {
 }
 
 impl Statement {
+    /// The options of a texture statement that lumiere does not honour (`map_Kd -s 2 2 1 …`), as
+    /// `"map_Kd -s"`: they cost a warning, since scaling or offsetting a texture changes what a
+    /// surface looks like. `-clamp off` is the default, repeat wrapping, which lumiere does.
+    fn texture_option(&self) -> Option<String> {
+        let (keyword, options) = match self {
+            Statement::DiffuseMap(map) => ("map_Kd", &map.options),
+            Statement::CoverageMap(map) => ("map_d", &map.options),
+            _ => return None,
+        };
+        (!options.is_empty()).then(|| quote(format!("{keyword} {}", options.join(" "))))
+    }
+
     fn apply(self, material: &mut Material) {
         match self {
             Statement::NewMtl(name) => material.name = name,
@@ -85,8 +127,8 @@ impl Statement {
             Statement::RefractiveIndex(ni) => material.ni = ni,
             Statement::Dissolve(d) => material.dissolve = d,
             Statement::Illumination(illum) => material.illum = illum,
-            Statement::DiffuseMap(path) => material.map_kd = Some(path),
-            Statement::CoverageMap(path) => material.map_d = Some(path),
+            Statement::DiffuseMap(map) => material.map_kd = Some(map.path),
+            Statement::CoverageMap(map) => material.map_d = Some(map.path),
             Statement::TransmissionFilter(tf) => material.tf = tf,
             Statement::Metallic(pm) => material.metallic = Some(pm),
             Statement::Roughness(pr) => material.roughness = Some(pr),
@@ -108,7 +150,7 @@ fn parse_statement(line: &[u8], folder: &Path) -> Result<Option<Statement>, Stri
         b"newmtl" => Statement::NewMtl(material_name(tokens)?),
         b"Kd" => Statement::Diffuse(color(tokens)?),
         b"Ks" => Statement::Specular(color(tokens)?),
-        b"Ke" => Statement::Emission(color(tokens)?),
+        b"Ke" => Statement::Emission(emission(tokens)?),
         b"Ns" => Statement::Shininess(scalar(tokens)?),
         b"Ni" => Statement::RefractiveIndex(scalar(tokens)?),
         // `d -halo 0.5` is an old variant; the halo itself is ignored.
@@ -145,6 +187,16 @@ fn color<'a>(tokens: impl Iterator<Item = &'a [u8]>) -> Result<Vec3, String> {
     }
 }
 
+/// An emitted radiance: a colour none of whose components is negative (light cannot be taken
+/// away; a negative weight would also leave the scene without power-proportional light choice).
+fn emission<'a>(tokens: impl Iterator<Item = &'a [u8]>) -> Result<Vec3, String> {
+    let ke = color(tokens)?;
+    if ke.min_element() < 0.0 {
+        return Err(format!("Ke must not be negative, found {} {} {}", ke.x, ke.y, ke.z));
+    }
+    Ok(ke)
+}
+
 fn scalar<'a>(mut tokens: impl Iterator<Item = &'a [u8]>) -> Result<f32, String> {
     match (tokens.next(), tokens.next()) {
         (Some(token), None) => finite_f32(token),
@@ -162,10 +214,30 @@ fn integer<'a>(mut tokens: impl Iterator<Item = &'a [u8]>) -> Result<u32, String
     }
 }
 
-/// The texture file is the last token: options such as `-bm 1` or `-o 0 0 0` come before it.
-/// Backslashes become slashes, since files exported on Windows use them as separators.
-fn texture_path<'a>(keyword: &str, tokens: impl Iterator<Item = &'a [u8]>, folder: &Path) -> Result<PathBuf, String> {
-    let file = tokens.last().ok_or_else(|| format!("{keyword} without a file name"))?;
+/// A texture statement: the file, and the options written before it that lumiere ignores.
+struct TextureMap {
+    path: PathBuf,
+    options: Vec<String>,
+}
+
+/// The texture file is the last token: options such as `-bm 1` or `-o 0 0 0` come before it, an
+/// option being a token that starts with `-` and is not a number. Backslashes become slashes,
+/// since files exported on Windows use them as separators.
+fn texture_path<'a>(
+    keyword: &str,
+    tokens: impl Iterator<Item = &'a [u8]>,
+    folder: &Path,
+) -> Result<TextureMap, String> {
+    let tokens: Vec<&[u8]> = tokens.collect();
+    let (file, before) = tokens.split_last().ok_or_else(|| format!("{keyword} without a file name"))?;
+    let mut options = Vec::new();
+    for (k, token) in before.iter().enumerate() {
+        let is_option = token.starts_with(b"-") && finite_f32(token).is_err();
+        let default_wrap = *token == b"-clamp" && before.get(k + 1) == Some(&&b"off"[..]);
+        if is_option && !default_wrap {
+            options.push(String::from_utf8_lossy(token).into_owned());
+        }
+    }
     let file = String::from_utf8_lossy(file).replace('\\', "/");
-    Ok(folder.join(file))
+    Ok(TextureMap { path: folder.join(file), options })
 }
