@@ -206,9 +206,9 @@ pub struct RenderArgs {
     #[arg(long, value_parser = parse_vec3, requires = "eye", allow_hyphen_values = true)]
     pub target: Option<Vec3>,
 
-    /// Look-at camera up direction, x,y,z.
-    #[arg(long, value_parser = parse_vec3, default_value = "0,1,0", allow_hyphen_values = true)]
-    pub up: Vec3,
+    /// Look-at camera up direction, x,y,z (also for the view that frames a scene). [default: 0,1,0]
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub up: Option<Vec3>,
 
     /// Vertical field of view of the look-at camera, in degrees, between 0 and 180 (exclusive);
     /// orbiter cameras use gKit's 45. [default: 45]
@@ -236,9 +236,9 @@ pub struct RenderArgs {
     #[arg(long)]
     pub png_linear: bool,
 
-    /// Exposure of the PNG in stops: each +1 doubles the brightness (EXR and PFM stay linear).
-    #[arg(long, default_value_t = 0.0, value_parser = parse_exposure, allow_hyphen_values = true)]
-    pub exposure: f32,
+    /// Exposure of the PNG in stops: each +1 doubles the brightness (EXR and PFM stay linear). [default: 0]
+    #[arg(long, value_parser = parse_exposure, allow_hyphen_values = true)]
+    pub exposure: Option<f32>,
 
     /// How the PNG maps radiance to the display: clamp (clip at 1, the lab's images) or aces (a
     /// filmic curve). [default: aces for path, clamp for the lab's modes]
@@ -260,7 +260,7 @@ pub struct RenderArgs {
     #[arg(long)]
     pub stats_json: Option<PathBuf>,
 
-    /// Stop after the pass that crosses this rendering time (e.g. 30s, 5m, 1h, 1.5s).
+    /// Stop after this much rendering time in this run, keeping the completed passes (e.g. 30s, 5m, 1h, 1.5s).
     #[arg(long, value_parser = parse_duration, allow_hyphen_values = true)]
     pub time: Option<std::time::Duration>,
 
@@ -276,9 +276,9 @@ pub struct RenderArgs {
     #[arg(long)]
     pub checkpoint: Option<PathBuf>,
 
-    /// Seconds between checkpoints; 0 saves after every pass.
-    #[arg(long, default_value_t = 0.0, value_parser = parse_non_negative_f64, allow_hyphen_values = true)]
-    pub checkpoint_every: f64,
+    /// Seconds between checkpoints (with --checkpoint); 0 saves after every pass. [default: 0]
+    #[arg(long, value_parser = parse_non_negative_f64, allow_hyphen_values = true)]
+    pub checkpoint_every: Option<f64>,
 
     /// Continue the render saved in this checkpoint (same scene and options; --spp may grow).
     #[arg(long)]

@@ -274,6 +274,34 @@ fn flags_that_do_nothing_are_warned() {
     for flag in ["--samples", "--ao-distance", "--light-sampling", "--fov"] {
         assert!(message.contains(&format!("warning: {flag} has no effect")), "{flag}: {message}");
     }
+    assert!(!message.contains("--up"), "{message}");
+
+    // The PNG's flags on a linear output, --up on the built-in scene's orbiter, and a checkpoint
+    // period without a checkpoint.
+    let out = run(&[
+        "render",
+        "--size",
+        "8x6",
+        "--spp",
+        "1",
+        "--exposure",
+        "1",
+        "--tonemap",
+        "clamp",
+        "--png-linear",
+        "--up",
+        "1,0,0",
+        "--checkpoint-every",
+        "5",
+        "-o",
+        &dir.arg("o.exr"),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let message = stderr(&out);
+    for flag in ["--exposure", "--tonemap", "--png-linear", "--up", "--checkpoint-every"] {
+        assert!(message.contains(&format!("warning: {flag} has no effect")), "{flag}: {message}");
+    }
+    assert!(message.contains("on a .exr output (PNG only"), "{message}");
 }
 
 /// A render of one sample per pixel centre cannot be continued with jittered samples: the

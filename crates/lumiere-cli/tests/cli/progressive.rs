@@ -194,7 +194,7 @@ fn resuming_with_other_inputs_or_a_broken_file_is_refused() {
     assert!(run.status.success(), "{}", stderr(&run));
 
     let mcguire = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/corpus/seeds/CornellBox-Original.obj");
-    let cases: [(&[&str], &str); 4] = [
+    let cases: [(&[&str], &str); 5] = [
         (&["render", mcguire, "--mode", "ao", "--samples", "4", "--spp", "4", "--size", "32x24"], "different scene"),
         // A refusal names the option that differs, with both values.
         (
@@ -204,6 +204,11 @@ fn resuming_with_other_inputs_or_a_broken_file_is_refused() {
         (
             &["render", "--mode", "ao", "--samples", "4", "--spp", "4", "--size", "32x24", "--seed", "9"],
             "other options: seed (checkpoint: 0; now: 9)",
+        ),
+        // The camera's matrices are too long to quote; the size is named.
+        (
+            &["render", "--mode", "ao", "--samples", "4", "--spp", "4", "--size", "32x20"],
+            "other options: image size (checkpoint: 32x24; now: 32x20), camera (differs from the checkpoint's);",
         ),
         (
             &[

@@ -1,5 +1,6 @@
 //! The camera the user asked for.
 
+use glam::Vec3;
 use lumiere::scene::camera::{self, Camera, Orbiter};
 use lumiere::scene::{Scene, builtin};
 use lumiere::{Error, Result};
@@ -14,12 +15,17 @@ pub fn from_args(args: &RenderArgs, scene: &Scene) -> Result<Camera> {
         return Ok(Camera::from_orbiter(&Orbiter::load(path)?, width, height));
     }
     if let (Some(eye), Some(target)) = (args.eye, args.target) {
-        return Camera::look_at(eye, target, args.up, fov, width, height);
+        return Camera::look_at(eye, target, up(args), fov, width, height);
     }
     if args.scene.is_none() {
         return Ok(Camera::from_orbiter(&builtin::cornell_orbiter()?, width, height));
     }
     let (eye, target) = camera::framing(&scene.bounds(), fov)
         .map_err(|why| Error::invalid(format!("{}: {why}; give --eye and --target", scene.name)))?;
-    Camera::look_at(eye, target, args.up, fov, width, height)
+    Camera::look_at(eye, target, up(args), fov, width, height)
+}
+
+/// The look-at camera's up direction: `--up`, or +y.
+fn up(args: &RenderArgs) -> Vec3 {
+    args.up.unwrap_or(Vec3::Y)
 }

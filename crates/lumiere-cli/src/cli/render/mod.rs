@@ -122,7 +122,7 @@ fn render_passes(
             last_preview = Instant::now();
         }
         if let Some(path) = &args.checkpoint
-            && last_checkpoint.elapsed().as_secs_f64() >= args.checkpoint_every
+            && last_checkpoint.elapsed().as_secs_f64() >= args.checkpoint_every.unwrap_or(0.0)
         {
             fingerprints.save(path, film, stats)?;
             last_checkpoint = Instant::now();
@@ -197,7 +197,7 @@ fn png_style(args: &RenderArgs) -> PngStyle {
     let filmic = args.mode == ModeArg::Path;
     PngStyle {
         encoding: if args.png_linear { PngEncoding::GkitLinear } else { PngEncoding::Srgb },
-        exposure: args.exposure,
+        exposure: args.exposure.unwrap_or(0.0),
         tonemap: match args.tonemap {
             Some(TonemapArg::Aces) => Tonemap::Aces,
             Some(TonemapArg::Clamp) => Tonemap::Clamp,

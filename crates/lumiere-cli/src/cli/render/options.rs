@@ -77,10 +77,35 @@ pub fn ignored_flags(args: &RenderArgs) -> Vec<String> {
     check(args.light_sampling.is_some(), "--light-sampling", mode == ModeArg::Direct, "direct only");
     check(args.ao_distance.is_some(), "--ao-distance", mode == ModeArg::Ao, "ao only");
     check(args.max_depth.is_some(), "--max-depth", mode == ModeArg::Path, "path only");
-    if args.fov.is_some() && args.orbiter.is_some() {
-        ignored.push("--fov has no effect with --orbiter (gKit's orbiter camera uses 45 degrees)".to_string());
-    } else if args.fov.is_some() && args.scene.is_none() && args.eye.is_none() {
-        ignored.push("--fov has no effect on the built-in scene's orbiter camera; give --eye and --target".to_string());
+    for (flag, given) in [("--fov", args.fov.is_some()), ("--up", args.up.is_some())] {
+        if given && args.orbiter.is_some() {
+            ignored.push(format!("{flag} has no effect with --orbiter (gKit's orbiter camera has its own)"));
+        } else if given && args.scene.is_none() && args.eye.is_none() {
+            ignored
+                .push(format!("{flag} has no effect on the built-in scene's orbiter camera; give --eye and --target"));
+        }
+    }
+    let png = args.output.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    let png_only = [
+        ("--exposure", args.exposure.is_some()),
+        ("--tonemap", args.tonemap.is_some()),
+        ("--png-linear", args.png_linear),
+    ];
+    for (flag, given) in png_only {
+        if given && !png {
+            ignored.push(format!(
+                "{flag} has no effect on a {} output (PNG only: EXR and PFM stay linear)",
+                extension(args)
+            ));
+        }
+    }
+    if args.checkpoint_every.is_some() && args.checkpoint.is_none() {
+        ignored.push("--checkpoint-every has no effect without --checkpoint".to_string());
     }
     ignored
+}
+
+/// The output's extension, as written (`.exr`), for messages.
+fn extension(args: &RenderArgs) -> String {
+    args.output.extension().map_or_else(|| "extensionless".to_string(), |e| format!(".{}", e.to_string_lossy()))
 }
