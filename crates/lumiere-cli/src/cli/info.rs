@@ -1,5 +1,5 @@
-//! `lumiere info`: what is in a scene — counts, materials by name (what `--emission` needs), their
-//! textures, lights, bounds — and its load warnings.
+//! `lumiere info`: what is in a scene — counts, materials by name (what `--emission` needs) with
+//! the scattering each maps to and their textures, lights, bounds — and its load warnings.
 
 use std::fmt::Display;
 use std::time::Instant;
@@ -8,7 +8,7 @@ use glam::Vec3;
 
 use lumiere::Result;
 use lumiere::lights::LightSet;
-use lumiere::materials::Material;
+use lumiere::materials::{Material, MaterialKind};
 use lumiere::scene::Scene;
 
 use super::args::InfoArgs;
@@ -59,11 +59,28 @@ fn line(key: &str, value: impl Display) -> Result<()> {
     output::print(format_args!("{key:<11}{value}"))
 }
 
-/// What lumiere uses of a material: its colour, its texture, its cutout mask, its emission.
+/// What lumiere uses of a material: the scattering its statements map to (docs/MATERIALS.md), its
+/// colour, its texture, its cutout mask, its emission.
 fn describe(material: &Material) -> String {
-    let mut parts = vec![format!("Kd {}", vector(material.kd))];
-    if let Some(texture) = &material.map_kd {
-        parts.push(format!("map_Kd {:?}", texture.display().to_string()));
+    let kind = material.kind();
+    let details = match kind {
+        MaterialKind::Lambert => None,
+        MaterialKind::Plastic { ks, alpha } => Some(format!("Ks {}, alpha {}", vector(ks), number(alpha))),
+        MaterialKind::Conductor { alpha } => Some(format!("F0 the base colour, alpha {}", number(alpha))),
+        MaterialKind::Mirror { f0 } => Some(format!("F0 {}", vector(f0))),
+        MaterialKind::Dielectric { eta, tf } => Some(format!("eta {}, Tf {}", number(eta), vector(tf))),
+    };
+    let scattering = match details {
+        Some(details) => format!("{} ({details})", kind.name()),
+        None => kind.name().to_string(),
+    };
+    let mut parts = vec![scattering];
+    // A mirror of `Ks` and glass ignore the base colour.
+    if !matches!(kind, MaterialKind::Mirror { .. } | MaterialKind::Dielectric { .. }) {
+        parts.push(format!("Kd {}", vector(material.kd)));
+        if let Some(texture) = &material.map_kd {
+            parts.push(format!("map_Kd {:?}", texture.display().to_string()));
+        }
     }
     if let Some(mask) = &material.map_d {
         parts.push(format!("map_d {:?} (cutout)", mask.display().to_string()));

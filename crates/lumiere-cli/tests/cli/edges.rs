@@ -375,14 +375,31 @@ fn ctrl_c_while_loading_exits_3_and_writes_nothing() {
 }
 
 /// `info` works on the built-in scene, names every material (what `--emission` needs) with its
-/// triangle count, and never prints a negative zero.
+/// triangle count and the scattering it maps to, and never prints a negative zero.
 #[test]
 fn info_names_materials_and_prints_no_negative_zero() {
     let out = run(&["info"]);
     assert!(out.status.success(), "{}", stderr(&out));
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(text.contains("\"light.001\": 2 triangles") && text.contains("(a light)"), "{text}");
+    assert!(text.contains("\"light.001\": 2 triangles, lambert, Kd") && text.contains("(a light)"), "{text}");
     assert!(text.contains("materials  8"), "{text}");
+    let dir = TempDir::new("info-kinds");
+    dir.write("kinds.mtl", "newmtl glass\nKd 0 0 0\nKs 1 1 1\nNi 1.5\nillum 7\nnewmtl mirror\nKd 0 0 0\nKs 1 1 1\nillum 3\nnewmtl brass\nKd 0.5 0.4 0.3\nPm 1\nPr 0.5\n");
+    let scene = dir.write(
+        "kinds.obj",
+        "mtllib kinds.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl glass\nf 1 2 3\nusemtl mirror\nf 1 2 3\nusemtl brass\nf 1 2 3\n",
+    );
+    let out = run(&["info", scene.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("\"glass\": 1 triangles, dielectric (eta 1.500000, Tf (1.000000, 1.000000, 1.000000))\n"),
+        "{text}"
+    );
+    assert!(text.contains("\"mirror\": 1 triangles, mirror (F0 (1.000000, 1.000000, 1.000000))\n"), "{text}");
+    assert!(
+        text.contains("\"brass\": 1 triangles, conductor (F0 the base colour, alpha 0.250000), Kd (0.500000"),
+        "{text}"
+    );
     let dir = TempDir::new("info-unlit");
     let scene = dir.write("unlit.obj", "v 0 0 0\nv -1 0 0\nv 0 -1 0\nf 1 2 3\n");
     let out = run(&["info", scene.to_str().unwrap()]);

@@ -38,8 +38,9 @@ pub fn progress_bar(total: u64, done: u64) -> ProgressBar {
 pub fn summary(options: &RenderOptions, camera: &Camera, output: &RenderOutput, threads: usize, path: &Path) {
     let noise = output.film.relative_error().map_or(String::new(), |e| format!(", relative error {e:.4}"));
     let asked = if options.spp == u32::MAX { "unlimited".to_string() } else { options.spp.to_string() };
+    let threads = if threads == 1 { "1 thread".to_string() } else { format!("{threads} threads") };
     output::note(format_args!(
-        "{} {}x{}: {} after {} of {asked} spp{noise}; {:.1} ms ({threads} threads), {} rays, {:.1} Mrays/s -> {}",
+        "{} {}x{}: {} after {} of {asked} spp{noise}; {:.1} ms ({threads}), {} rays, {:.1} Mrays/s -> {}",
         options.technique.name(),
         camera.width,
         camera.height,
