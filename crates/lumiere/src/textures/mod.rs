@@ -389,7 +389,9 @@ impl TextureSet {
                     set.textures.push(texture);
                     set.paths.push(path.to_path_buf());
                 }
-                Err(reason) => warnings.push(format!("texture \"{}\": {reason}; {instead}", path.display())),
+                // Quoted and escaped like a string literal (not cut: the user must find the file),
+                // so that a control character from the MTL file cannot garble the line.
+                Err(reason) => warnings.push(format!("texture {:?}: {reason}; {instead}", path.to_string_lossy())),
             }
         }
         (set, warnings)

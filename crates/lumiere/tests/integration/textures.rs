@@ -208,6 +208,10 @@ fn unusable_files_cost_one_warning_each_and_no_texture() {
         assert_eq!(warning.lines().count(), 1);
     }
     assert!(warnings[3].contains("not a regular file"), "{}", warnings[3]);
+    // A path with a control character (from an MTL line) is escaped, never printed raw.
+    let odd = dir.path("odd\u{1b}[2Jname.png");
+    let (_, _, warnings) = TextureSet::for_materials([Some(odd.as_path())]);
+    assert!(warnings[0].contains("odd\\u{1b}[2Jname.png") && !warnings[0].contains('\u{1b}'), "{}", warnings[0]);
 }
 
 /// A PNG whose header claims 20000 × 20000 pixels is refused from the header, before decoding.
