@@ -21,6 +21,9 @@ pub fn write_image(
     exposure: f32,
     tonemap: &str,
 ) -> PyResult<()> {
+    if !exposure.is_finite() {
+        return Err(invalid(format!("exposure must be a finite number of stops, got {exposure}")));
+    }
     let tonemap = match tonemap {
         "aces" => Tonemap::Aces,
         "clamp" => Tonemap::Clamp,

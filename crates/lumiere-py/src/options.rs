@@ -24,11 +24,12 @@ pub struct PyOptions {
     pub ignored: Vec<String>,
 }
 
-fn positive_count(value: i64, what: &str) -> PyResult<u32> {
+/// `value` as a count from 1 to `max`.
+fn positive_count(value: i64, what: &str, max: u32) -> PyResult<u32> {
     u32::try_from(value)
         .ok()
-        .filter(|&v| v >= 1)
-        .ok_or_else(|| invalid(format!("{what} must be at least 1, got {value}")))
+        .filter(|&v| (1..=max).contains(&v))
+        .ok_or_else(|| invalid(format!("{what} must be between 1 and {max}, got {value}")))
 }
 
 #[pymethods]
@@ -49,7 +50,8 @@ impl PyOptions {
         time: Option<f64>,
         noise: Option<f64>,
     ) -> PyResult<Self> {
-        let samples_value = samples.map(|s| positive_count(s, "samples")).transpose()?.unwrap_or(DEFAULT_SAMPLES);
+        let samples_value =
+            samples.map(|s| positive_count(s, "samples", u32::MAX)).transpose()?.unwrap_or(DEFAULT_SAMPLES);
         let technique = match mode {
             "hits" => Technique::Hits(Hits),
             "materials" => Technique::Materials(Materials),
@@ -95,7 +97,8 @@ impl PyOptions {
         let time_budget = seconds(time, "time")?;
         let budget = time.is_some() || noise.is_some();
         let spp = match spp {
-            Some(spp) => positive_count(spp, "spp")?,
+            // `u32::MAX` stands for "until a budget stops the render" (`spp=None`).
+            Some(spp) => positive_count(spp, "spp", u32::MAX - 1)?,
             None if budget => u32::MAX,
             None => return Err(invalid("spp=None needs a budget: give time= or noise=")),
         };

@@ -16,12 +16,23 @@ use crate::pixels::to_bytearray;
 use crate::scene::PyScene;
 use crate::watch::{self, Watch};
 
+/// The most worker threads a render may ask for, as the CLI's `--threads`.
+const MAX_THREADS: usize = 1024;
+
 /// A rayon pool of `threads` workers (0: one per core), as the CLI builds it, kept for the next
-/// render with that many: starting threads for every call would cost milliseconds a render.
+/// render with that many: starting threads for every call would cost milliseconds a render. Only
+/// the last pool is kept (its threads live as long as it does), so a notebook that tries one
+/// thread count after another does not pile up threads; a render still running on a replaced
+/// pool keeps it until it ends.
 pub fn pool(threads: usize) -> PyResult<Arc<rayon::ThreadPool>> {
-    static POOLS: Mutex<Vec<(usize, Arc<rayon::ThreadPool>)>> = Mutex::new(Vec::new());
-    let mut pools = POOLS.lock().unwrap_or_else(|e| e.into_inner());
-    if let Some((_, pool)) = pools.iter().find(|(n, _)| *n == threads) {
+    if threads > MAX_THREADS {
+        return Err(invalid(format!("threads must be at most {MAX_THREADS}, got {threads}")));
+    }
+    static LAST: Mutex<Option<(usize, Arc<rayon::ThreadPool>)>> = Mutex::new(None);
+    let mut last = LAST.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some((count, pool)) = &*last
+        && *count == threads
+    {
         return Ok(pool.clone());
     }
     let pool = rayon::ThreadPoolBuilder::new()
@@ -29,7 +40,7 @@ pub fn pool(threads: usize) -> PyResult<Arc<rayon::ThreadPool>> {
         .build()
         .map_err(|e| invalid(format!("cannot start {threads} threads: {e}")))?;
     let pool = Arc::new(pool);
-    pools.push((threads, pool.clone()));
+    *last = Some((threads, pool.clone()));
     Ok(pool)
 }
 
@@ -60,7 +71,11 @@ pub fn render<'py>(
             };
             let hooks = Hooks { progress: &count, pass_done: &mut |_, _| Ok(()), cancel: &watch.cancel };
             let output = render_progressive(world, camera, options, film, RenderStats::default(), hooks)?;
-            let buffers = if aovs.is_empty() { Vec::new() } else { render_aovs(world, camera, options, &aovs) };
+            // Empty when cancelled: `watch::run` then raises, and nothing is returned.
+            let buffers = match aovs.is_empty() {
+                true => Vec::new(),
+                false => render_aovs(world, camera, options, &aovs, &watch.cancel).unwrap_or_default(),
+            };
             Ok((output, buffers))
         })
     };

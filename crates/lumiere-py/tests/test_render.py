@@ -168,7 +168,7 @@ def test_errors_carry_the_cli_message(cli, tmp_path):
         lumiere.Camera.look_at((0, 0, 0), (0, 0, 0))
     with pytest.raises(lumiere.LumiereError, match="unknown mode"):
         lumiere.render(lumiere.builtin(), mode="nope")
-    with pytest.raises(lumiere.LumiereError, match="at least 1"):
+    with pytest.raises(lumiere.LumiereError, match="spp must be between 1 and 4294967294, got 0"):
         lumiere.render(lumiere.builtin(), spp=0)
     with pytest.raises(lumiere.LumiereError, match="unknown AOV"):
         lumiere.render(lumiere.builtin(), spp=1, size=(8, 6), aovs=("speed",))
@@ -176,6 +176,43 @@ def test_errors_carry_the_cli_message(cli, tmp_path):
         lumiere.render(lumiere.builtin(), spp=1, sample=3)
     with pytest.warns(UserWarning, match="samples has no effect"):
         lumiere.render(lumiere.builtin(), spp=1, size=(8, 6), samples=4)
+
+
+def test_numbers_are_checked_as_the_cli_checks_them(tmp_path):
+    scene = lumiere.builtin()
+    small = {"spp": 1, "size": (8, 6)}
+    # Integers of any kind numpy or Python has, never a bool, a float or one out of range.
+    image = lumiere.render(scene, seed=np.int64(2), threads=np.int32(1), **small)
+    assert np.array_equal(bits(image), bits(lumiere.render(scene, seed=2, threads=1, **small)))
+    refused = [
+        ({"threads": 2000}, "threads .* must be between 0 and 1024"),
+        ({"threads": True}, "must be an integer"),
+        ({"seed": -1}, "seed must be between 0"),
+        ({"spp": 2**32}, "spp must be between 1 and 4294967294"),
+        ({"spp": True}, "spp must be an integer"),
+        ({"size": (8.9, 8.2)}, "size must be an integer"),
+        ({"size": (2**32, 1)}, "size must be between 0 and 4294967295"),
+        ({"max_depth": -1}, "max_depth must be between 0"),
+        ({"samples": 0, "mode": "ao"}, "samples must be between 1"),
+    ]
+    for kwargs, message in refused:
+        with pytest.raises(lumiere.LumiereError, match=message):
+            lumiere.render(scene, **{**small, **kwargs})
+    # Emission, colours and normals: finite, and emission not negative, as the loaders require.
+    for ke in ((float("nan"), 1, 1), (-5, 1, 1), (float("inf"), 1, 1)):
+        with pytest.raises(lumiere.LumiereError, match="must be finite and not negative"):
+            lumiere.builtin(emission={"light.001": ke})
+    vertices = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], dtype=np.float32)
+    with pytest.raises(lumiere.LumiereError, match="must be finite"):
+        lumiere.Scene.from_arrays(vertices, [[0, 1, 2]], materials=[{"name": "m", "kd": (float("nan"), 0, 0)}])
+    normals = np.array([[0, 0, 1], [0, 0, 1], [0, float("nan"), 1]], dtype=np.float32)
+    with pytest.raises(lumiere.LumiereError, match="normal 2 is not finite"):
+        lumiere.Scene.from_arrays(vertices, [[0, 1, 2]], normals=normals)
+    with pytest.raises(lumiere.LumiereError, match="exposure must be a finite number"):
+        lumiere.write_image(tmp_path / "x.png", image, exposure=float("nan"))
+    assert not (tmp_path / "x.png").exists()
+    with pytest.raises(lumiere.LumiereError, match="is a directory, not a regular file"):
+        lumiere.load(tmp_path)
 
 
 def test_progress_is_reported_and_an_exception_stops_the_render():

@@ -9,7 +9,7 @@ from typing import Any, Callable, Dict, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from . import _lumiere
-from ._scene import DEFAULT_SIZE, Camera, Scene
+from ._scene import DEFAULT_SIZE, Camera, Scene, _integer
 from .errors import LumiereError
 
 __all__ = ["render", "render_full", "RenderResult", "MODES", "AOVS", "TECHNIQUE_OPTIONS"]
@@ -57,12 +57,14 @@ def _options(
         raise TypeError(
             f"render() got unexpected keyword arguments {sorted(unknown)}; technique options are {', '.join(TECHNIQUE_OPTIONS)}"
         )
-    if not isinstance(seed, int) or not 0 <= seed < 2**64:
-        raise LumiereError(f"seed must be an integer in [0, 2**64), got {seed!r}")
-    if spp is not None and not isinstance(spp, (int, np.integer)):
-        raise LumiereError(f"spp must be an integer, got {spp!r}")
+    seed = _integer(seed, "seed", 0, 2**64 - 1)
+    # 2**32 - 1 is the native side's "until a budget stops it", which spp=None asks for.
+    spp = None if spp is None else _integer(spp, "spp", 1, 2**32 - 2)
+    for name, low in (("samples", 1), ("max_depth", 0)):
+        if technique_options.get(name) is not None:
+            technique_options[name] = _integer(technique_options[name], name, low, 2**32 - 1)
     options = _lumiere.NativeOptions(
-        str(mode), None if spp is None else int(spp), seed, None if sampler is None else str(sampler), time=time, noise=noise, **technique_options
+        str(mode), spp, seed, None if sampler is None else str(sampler), time=time, noise=noise, **technique_options
     )
     for message in options.ignored:
         warnings.warn(message, stacklevel=3)
@@ -81,9 +83,8 @@ def _camera(scene: Scene, camera: Optional[Camera], size: Optional[Tuple[int, in
 
 
 def _threads(threads: int) -> int:
-    if not isinstance(threads, int) or threads < 0:
-        raise LumiereError(f"threads must be 0 (all cores) or more, got {threads!r}")
-    return threads
+    # 0 is one per core; at most 1024, as the CLI's --threads.
+    return _integer(threads, "threads (0 for one per core)", 0, 1024)
 
 
 def render_full(
@@ -149,7 +150,7 @@ def render(
     :param spp: camera samples per pixel (1 = the lab's pixel centres, more are jittered). None
         renders until ``time`` or ``noise`` stops it.
     :param seed: same seed, same values, whatever ``threads``.
-    :param threads: worker threads, 0 = all cores.
+    :param threads: worker threads, 0 = all cores, at most 1024.
     :param sampler: ``independent`` or ``sobol``; by default ``sobol`` for path, ``independent`` for
         the lab's modes (as the CLI).
     :param aovs: names among ``albedo``, ``normal``, ``depth``: the result is then a dict with

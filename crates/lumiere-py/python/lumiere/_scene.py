@@ -38,11 +38,22 @@ def _vector(value: Any, what: str) -> Tuple[float, float, float]:
     return (x, y, z)
 
 
+def _integer(value: Any, what: str, low: int, high: int) -> int:
+    """`value` as an int, if it is an integer (a numpy integer too; not a bool, not a float) in
+    [low, high]: the native side takes fixed-size integers, which must not overflow or truncate."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        raise LumiereError(f"{what} must be an integer, got {value!r}")
+    if not low <= int(value) <= high:
+        raise LumiereError(f"{what} must be between {low} and {high}, got {value!r}")
+    return int(value)
+
+
 def _size(size: Any) -> Tuple[int, int]:
     try:
-        width, height = (int(v) for v in size)
+        width, height = size
     except (TypeError, ValueError):
         raise LumiereError(f"size must be (width, height), got {size!r}") from None
+    width, height = (_integer(v, "size", 0, 2**32 - 1) for v in (width, height))
     if width <= 0 or height <= 0:
         raise LumiereError(f"image size {width}x{height} has no pixels")
     return (width, height)

@@ -5,6 +5,8 @@
 //! camera samples (up to [`AOV_SAMPLES`] per pixel), so they line up with the image and cost a few
 //! first-hit rays per pixel whatever the technique.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -51,7 +53,17 @@ impl Aov {
 
 /// The requested AOVs of the render `options` describes, each as one value per pixel (row 0 at
 /// the top), in the order asked.
-pub fn render_aovs(world: &World, camera: &Camera, options: &RenderOptions, aovs: &[Aov]) -> Vec<Vec<Vec3>> {
+///
+/// `cancel` is polled before each row: once it is set, the rows not started are skipped and the
+/// pass ends with `None`, so a caller that stops on it (Python's Ctrl-C) does not wait seconds for
+/// buffers it would throw away.
+pub fn render_aovs(
+    world: &World,
+    camera: &Camera,
+    options: &RenderOptions,
+    aovs: &[Aov],
+    cancel: &AtomicBool,
+) -> Option<Vec<Vec<Vec3>>> {
     let sampler = Sampler::new(options.sampler, options.seed);
     let samples = options.spp.clamp(1, AOV_SAMPLES);
     let centre = options.samples_pixel_centres();
@@ -59,6 +71,9 @@ pub fn render_aovs(world: &World, camera: &Camera, options: &RenderOptions, aovs
     let rows: Vec<Vec<[Vec3; 3]>> = (0..camera.height)
         .into_par_iter()
         .map(|y| {
+            if cancel.load(Ordering::Relaxed) {
+                return Vec::new();
+            }
             (0..width)
                 .map(|x| {
                     let mut sum = [Vec3::ZERO; 3];
@@ -75,7 +90,11 @@ pub fn render_aovs(world: &World, camera: &Camera, options: &RenderOptions, aovs
                 .collect()
         })
         .collect();
-    aovs.iter()
+    if cancel.load(Ordering::Relaxed) {
+        return None;
+    }
+    let buffers = aovs
+        .iter()
         .map(|aov| {
             let index = match aov {
                 Aov::Albedo => 0,
@@ -84,5 +103,6 @@ pub fn render_aovs(world: &World, camera: &Camera, options: &RenderOptions, aovs
             };
             rows.iter().flatten().map(|values| values[index]).collect()
         })
-        .collect()
+        .collect();
+    Some(buffers)
 }

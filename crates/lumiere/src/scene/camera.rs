@@ -148,6 +148,9 @@ impl Camera {
 
     /// A pinhole at `eye` looking at `target`, with vertical field of view `fov_degrees`.
     pub fn look_at(eye: Vec3, target: Vec3, up: Vec3, fov_degrees: f32, width: u32, height: u32) -> Result<Camera> {
+        if !(eye.is_finite() && target.is_finite()) {
+            return Err(Error::invalid(format!("camera: --eye {eye} and --target {target} must be finite")));
+        }
         let view = target - eye;
         if !view.is_finite() {
             return Err(Error::invalid("camera: --eye and --target are too far apart (their difference overflows)"));

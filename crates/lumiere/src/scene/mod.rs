@@ -61,18 +61,33 @@ impl Scene {
         if let Some(bad) = mesh.indices.iter().flatten().find(|&&i| i as usize >= mesh.positions.len()) {
             return Err(Error::invalid(format!("{name}: vertex index {bad} out of range")));
         }
-        // The loaders check this already; scenes made from arrays (Python) are checked here.
+        // The loaders check these already; scenes made from arrays (Python) are checked here.
         if let Some(bad) = materials.iter().find(|m| !(m.ke.is_finite() && m.ke.min_element() >= 0.0)) {
             return Err(Error::invalid(format!(
                 "{name}: material '{}': emission {} {} {} must be finite and not negative",
                 bad.name, bad.ke.x, bad.ke.y, bad.ke.z
             )));
         }
+        if let Some(bad) = materials.iter().find(|m| !m.kd.is_finite()) {
+            return Err(Error::invalid(format!(
+                "{name}: material '{}': colour {} {} {} must be finite",
+                bad.name, bad.kd.x, bad.kd.y, bad.kd.z
+            )));
+        }
+        if let Some(bad) = mesh.normals.iter().position(|n| !n.is_finite()) {
+            return Err(Error::invalid(format!("{name}: normal {bad} is not finite")));
+        }
         Ok(Scene { name, mesh, materials, warnings, sources: Vec::new() })
     }
 
     /// Sets the emission of every material called `name`.
     pub fn set_emission(&mut self, name: &str, emission: Vec3) -> Result<()> {
+        if !(emission.is_finite() && emission.min_element() >= 0.0) {
+            return Err(Error::invalid(format!(
+                "{}: material '{name}': emission {} {} {} must be finite and not negative",
+                self.name, emission.x, emission.y, emission.z
+            )));
+        }
         let mut found = false;
         for material in self.materials.iter_mut().filter(|m| m.name == name) {
             material.ke = emission;

@@ -43,7 +43,7 @@ pub fn read_regular_file(path: &Path) -> io::Result<Vec<u8>> {
 }
 
 /// An error unless `metadata` is a regular file's, saying what the file is instead.
-fn refuse_special(metadata: &std::fs::Metadata) -> io::Result<()> {
+pub fn refuse_special(metadata: &std::fs::Metadata) -> io::Result<()> {
     let kind = metadata.file_type();
     if kind.is_file() {
         return Ok(());

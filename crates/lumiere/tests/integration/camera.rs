@@ -66,6 +66,12 @@ fn look_at_rejects_degenerate_frames() {
     assert!(Camera::look_at(Vec3::ZERO, Vec3::ZERO, Vec3::Y, 45.0, 10, 10).is_err());
     assert!(Camera::look_at(Vec3::ZERO, Vec3::Y, Vec3::Y, 45.0, 10, 10).is_err());
     assert!(Camera::look_at(Vec3::ZERO, Vec3::Z, Vec3::Y, 180.0, 10, 10).is_err());
+    // A point that is not finite is named as such, not as a difference that overflows.
+    let nan = Vec3::new(f32::NAN, 0.0, 0.0);
+    for (eye, target) in [(nan, Vec3::ZERO), (Vec3::ZERO, Vec3::splat(f32::INFINITY))] {
+        let message = Camera::look_at(eye, target, Vec3::Y, 45.0, 10, 10).unwrap_err().to_string();
+        assert!(message.ends_with("must be finite"), "{message}");
+    }
 }
 
 /// Many rays at once are the rays one at a time, bit for bit, for both projections: film corners,

@@ -314,6 +314,24 @@ fn control_characters_in_names_and_paths_are_escaped() {
     assert_one_line(&[scene]);
 }
 
+/// A folder or a device given as the scene is named for what it is, whatever its name: before,
+/// `scenes/` and `/dev/zero` were "a file name with no extension".
+#[test]
+#[cfg(unix)]
+fn a_scene_that_is_not_a_regular_file_is_named_for_what_it_is() {
+    let dir = TempDir::new("scene-kinds");
+    std::fs::create_dir(dir.path("scenes")).unwrap();
+    std::fs::create_dir(dir.path("folder.obj")).unwrap();
+    for (path, expected) in [
+        (dir.path("scenes"), "is a directory, not a regular file"),
+        (dir.path("folder.obj"), "is a directory, not a regular file"),
+        (PathBuf::from("/dev/zero"), "is a character device, not a regular file"),
+    ] {
+        let message = load_error(&path);
+        assert!(message.ends_with(expected), "{}: {message}", path.display());
+    }
+}
+
 /// An MTL with 100 bad lines, named 2,000 times on one line and under five spellings on others:
 /// read once, 10 of its warnings shown and one line for the other 90. (Before: one read and 100
 /// warnings per name, 165 KB of OBJ gave 346 MB of warnings.)

@@ -330,13 +330,16 @@ fn aovs_match_the_first_hit_and_round_trip_through_exr() {
     use lumiere::render::{RenderOptions, render};
     use lumiere::scene::{Scene, builtin, camera::Camera};
     use lumiere::world::World;
+    use std::sync::atomic::AtomicBool;
 
     let world = World::new(Scene::builtin().unwrap(), Default::default());
     let camera = Camera::from_orbiter(&builtin::cornell_orbiter().unwrap(), 32, 24);
     let options = RenderOptions::new(Technique::Materials(Materials));
     let colours = render(&world, &camera, &options, &|_| {}).unwrap().image.pixels;
-    let aovs = render_aovs(&world, &camera, &options, &[Aov::Albedo, Aov::Normal, Aov::Depth]);
+    let all = [Aov::Albedo, Aov::Normal, Aov::Depth];
+    let aovs = render_aovs(&world, &camera, &options, &all, &AtomicBool::new(false)).expect("not cancelled");
     assert_eq!(aovs[0], colours, "albedo AOV = materials mode at pixel centres");
+    assert!(render_aovs(&world, &camera, &options, &all, &AtomicBool::new(true)).is_none(), "cancelled");
     for (i, (n, d)) in aovs[1].iter().zip(&aovs[2]).enumerate() {
         if colours[i] == Vec3::ZERO {
             continue;

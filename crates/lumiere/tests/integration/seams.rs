@@ -136,7 +136,29 @@ fn emission_that_is_negative_or_not_finite_is_refused() {
         let error = Scene::from_parts("lights".into(), scene.mesh.clone(), materials, vec![]).unwrap_err();
         let message = error.to_string();
         assert!(message.contains("material 'bright'") && message.contains("not negative"), "{message}");
+        // Set afterwards (`--emission`, Python's `emission=`), the same values are refused too.
+        let mut scene = light_scene();
+        let message = scene.set_emission("bright", ke).unwrap_err().to_string();
+        assert!(message.contains("material 'bright'") && message.contains("not negative"), "{message}");
     }
+}
+
+/// Scenes made from arrays (Python) get the checks the file loaders make: a colour or a normal
+/// that is not finite is refused, naming it.
+#[test]
+fn colours_and_normals_that_are_not_finite_are_refused() {
+    let scene = light_scene();
+    let mut materials = scene.materials.clone();
+    materials[2].kd = Vec3::new(0.5, f32::NAN, 0.5);
+    let error = Scene::from_parts("lights".into(), scene.mesh.clone(), materials, vec![]).unwrap_err();
+    assert!(error.to_string().contains("material 'bright': colour 0.5 NaN 0.5 must be finite"), "{error}");
+    let mut mesh = scene.mesh.clone();
+    mesh.normals = vec![Vec3::Z; mesh.positions.len()];
+    mesh.normal_indices = mesh.indices.clone();
+    assert!(Scene::from_parts("lights".into(), mesh.clone(), scene.materials.clone(), vec![]).is_ok());
+    mesh.normals[1] = Vec3::new(0.0, f32::INFINITY, 0.0);
+    let error = Scene::from_parts("lights".into(), mesh, scene.materials.clone(), vec![]).unwrap_err();
+    assert_eq!(error.to_string(), "lights: normal 1 is not finite");
 }
 
 /// Light choice by power and uniformly: observed frequencies match `choice_pmf`.

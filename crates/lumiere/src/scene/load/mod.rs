@@ -8,12 +8,18 @@ use std::path::Path;
 
 use crate::error::{Error, Result, shown_path};
 use crate::scene::Scene;
+use crate::util::read::refuse_special;
 
 /// The scene formats lumiere reads, named as in messages.
 const SUPPORTED: &str = ".obj or .obj.gz (with their .mtl files)";
 
 /// Loads the scene file at `path`, choosing the loader by its extension (case-insensitive).
 pub fn load(path: &Path) -> Result<Scene> {
+    // What the file is comes first: a folder's or a device's name says nothing of it (`scenes/`
+    // and `/dev/zero` have no extension). A path that cannot be read is left to the loader's error.
+    if let Ok(metadata) = std::fs::metadata(path) {
+        refuse_special(&metadata).map_err(|e| Error::io(path, e))?;
+    }
     let name = path.file_name().map(|n| n.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
     let stem = name.strip_suffix(".gz").unwrap_or(&name);
     let extension = Path::new(stem).extension().map(|e| e.to_string_lossy().into_owned()).unwrap_or_default();
