@@ -188,6 +188,10 @@ fn format_of(path: &Path) -> Result<Format> {
             "{}: .{other} is not an image format lumiere writes (supported: {SUPPORTED})",
             shown_path(path)
         ))),
+        // A folder (`-o renders/`) is named as one, as the writer names it.
+        None if path.is_dir() => {
+            Err(Error::invalid(format!("{}: is a directory, expected a file name", shown_path(path))))
+        }
         None => Err(Error::invalid(format!(
             "{}: the file name has no extension, so the image format is unknown (supported: {SUPPORTED})",
             shown_path(path)

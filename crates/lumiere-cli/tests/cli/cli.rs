@@ -253,12 +253,19 @@ fn bad_inputs_give_a_clear_error_and_no_file() {
     let unreadable_orbiter = dir.path("no_such_orbiter.txt");
     assert_refused(&dir, &["render", "--orbiter", unreadable_orbiter.to_str().unwrap()], "no_such_orbiter.txt");
 
-    // Unwritable output paths: a directory that does not exist, an unsupported extension.
-    for (path, expected) in [("/nonexistent-dir/x.png", "nonexistent-dir"), ("out.jpg", ".png")] {
+    // Unwritable output paths: a directory that does not exist, an unsupported extension, a
+    // directory (named as one, not as a file name without an extension).
+    let folder = std::env::temp_dir();
+    let folder = folder.to_str().unwrap();
+    for (path, expected) in [
+        ("/nonexistent-dir/x.png", "nonexistent-dir"),
+        ("out.jpg", ".png"),
+        (folder, "is a directory, expected a file name"),
+    ] {
         let run = lumiere(&["render", "--mode", "hits", "-o", path]);
         assert_eq!(run.status.code(), Some(2), "{}", stderr(&run));
         assert!(stderr(&run).contains(expected), "{}", stderr(&run));
-        assert!(!Path::new(path).exists());
+        assert!(path == folder || !Path::new(path).exists());
     }
     assert_eq!(dir.entries(), ["bad_number.obj", "inf.obj", "nan.obj", "range.obj"]);
 }
