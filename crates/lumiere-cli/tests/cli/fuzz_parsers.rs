@@ -9,7 +9,8 @@
 //! Case counts are fixed (about 3 s in all with `--release`); the seed is random per run, so each
 //! CI run searches new inputs, and a failure prints the minimal input. Reproduce a run with
 //! `PROPTEST_RNG_SEED=<n>`, search longer with `FUZZ_CASES_SCALE=<k>` (k times the cases), e.g.
-//! `FUZZ_CASES_SCALE=50 cargo test --release --test fuzz_parsers`. See docs/FUZZING.md.
+//! `FUZZ_CASES_SCALE=50 cargo test --release -p lumiere-cli --test cli fuzz_parsers`. See
+//! docs/FUZZING.md.
 
 use crate::harness::{
     checkpoint_target, guarded, mtl_target, obj_chunks_target, obj_target, orbiter_target, raw_checkpoint,
