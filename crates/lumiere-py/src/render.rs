@@ -72,9 +72,10 @@ pub fn render<'py>(
             let hooks = Hooks { progress: &count, pass_done: &mut |_, _| Ok(()), cancel: &watch.cancel };
             let output = render_progressive(world, camera, options, film, RenderStats::default(), hooks)?;
             // Empty when cancelled: `watch::run` then raises, and nothing is returned.
-            let buffers = match aovs.is_empty() {
-                true => Vec::new(),
-                false => render_aovs(world, camera, options, &aovs, &watch.cancel).unwrap_or_default(),
+            let buffers = if aovs.is_empty() {
+                Vec::new()
+            } else {
+                render_aovs(world, camera, options, &aovs, &watch.cancel).unwrap_or_default()
             };
             Ok((output, buffers))
         })

@@ -157,9 +157,10 @@ fn write_output(
     }
     // Not cancelled by a second Ctrl-C: the image written after an interrupted render needs them.
     let never = AtomicBool::new(false);
-    let buffers = match wanted.is_empty() {
-        true => Vec::new(),
-        false => render_aovs(world, camera, options, &wanted, &never).unwrap_or_default(),
+    let buffers = if wanted.is_empty() {
+        Vec::new()
+    } else {
+        render_aovs(world, camera, options, &wanted, &never).unwrap_or_default()
     };
     let buffer = |aov: Aov| -> &[Vec3] {
         let index = wanted.iter().position(|w| *w == aov).expect("the AOV was asked for");
