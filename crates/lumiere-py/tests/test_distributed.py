@@ -139,3 +139,5 @@ def test_bad_arguments_are_refused_before_connecting():
         distributed.render(lumiere.builtin(), spp=0, address="127.0.0.1:9")
     with pytest.raises(lumiere.LumiereError, match="tasks must be an integer of at least 1"):
         distributed.render(lumiere.builtin(), spp=2, tasks=0, address="127.0.0.1:9")
+    with pytest.raises(lumiere.LumiereError, match="threads_per_task must be at most 1024"):
+        distributed.render(lumiere.builtin(), spp=2, threads_per_task=5000, address="127.0.0.1:9")

@@ -143,6 +143,9 @@ def render_full(
     for name, value, least in (("tasks", tasks, 1), ("threads_per_task", threads_per_task, 1), ("max_retries", max_retries, 0)):
         if value is not None and (not isinstance(value, int) or value < least):
             raise LumiereError(f"{name} must be an integer of at least {least}, got {value!r}")
+    # Refused here, before connecting, rather than by every worker's thread pool.
+    if threads_per_task is not None and threads_per_task > 1024:
+        raise LumiereError(f"threads_per_task must be at most 1024 (as --threads), got {threads_per_task}")
     option_args = dict(mode=str(mode), spp=spp, seed=seed, sampler=None if sampler is None else str(sampler), **technique_options)
     options = _options(mode, spp, seed, sampler, None, None, technique_options)
     camera = _camera(scene, camera, size)
