@@ -43,8 +43,8 @@ pub struct BenchSamplerArgs {
 
 #[derive(Args, Debug)]
 pub struct BenchLabArgs {
-    /// Timed renders per row; the median is reported.
-    #[arg(long, default_value_t = 3)]
+    /// Timed renders per row (1 to 1000); the median is reported.
+    #[arg(long, default_value_t = 3, value_parser = parse_repeats)]
     pub repeats: usize,
 
     /// A reduced run for CI: 256x192, one render per row.
@@ -57,7 +57,7 @@ pub struct BenchLabArgs {
     pub isa: Option<Isa>,
 
     /// Also write the table as JSON to this file.
-    #[arg(long)]
+    #[arg(long, value_parser = parse_json_path)]
     pub json: Option<PathBuf>,
 }
 
@@ -71,8 +71,8 @@ pub struct BenchBvhArgs {
     #[arg(long, default_value = "../shared/scenes")]
     pub scenes_dir: PathBuf,
 
-    /// Thread counts to measure, comma-separated.
-    #[arg(long, value_delimiter = ',', default_value = "1,2")]
+    /// Thread counts to measure, comma-separated (each at most 1024; 0 = one per core).
+    #[arg(long, value_delimiter = ',', default_value = "1,2", value_parser = parse_threads)]
     pub threads: Vec<usize>,
 
     /// SIMD kernels of the BVH: avx512, avx2, sse2 or portable (default: the widest this CPU
@@ -80,8 +80,8 @@ pub struct BenchBvhArgs {
     #[arg(long, value_parser = parse_isa)]
     pub isa: Option<Isa>,
 
-    /// Timed repetitions per measurement; the median is reported.
-    #[arg(long, default_value_t = 5)]
+    /// Timed repetitions per measurement (1 to 1000); the median is reported.
+    #[arg(long, default_value_t = 5, value_parser = parse_repeats)]
     pub repeats: usize,
 
     /// Seed of the shadow and diffuse rays.
@@ -89,7 +89,7 @@ pub struct BenchBvhArgs {
     pub seed: u64,
 
     /// Also write the results as JSON to this file.
-    #[arg(long)]
+    #[arg(long, value_parser = parse_json_path)]
     pub json: Option<PathBuf>,
 
     /// Write each scene's triangles and ray sets (binary, see bench/README.md) under this folder,
@@ -329,6 +329,24 @@ fn parse_non_negative_f64(s: &str) -> Result<f64, String> {
 fn parse_positive_f32(s: &str) -> Result<f32, String> {
     let value = parse_positive_f64(s)? as f32;
     if value.is_finite() && value > 0.0 { Ok(value) } else { Err(format!("out of range, got {s:?}")) }
+}
+
+/// A benchmark's JSON output: a `.json` file, so that a slip (`--json scene.obj`) cannot replace an
+/// input or another file with the table, and a folder is refused before the benchmark runs.
+fn parse_json_path(s: &str) -> Result<PathBuf, String> {
+    let path = PathBuf::from(s);
+    match path.extension() {
+        Some(extension) if extension.eq_ignore_ascii_case("json") && !path.is_dir() => Ok(path),
+        _ => Err(format!("expected a .json file name, got {s:?}")),
+    }
+}
+
+/// Timed repetitions of a benchmark: at least one, and few enough that their times fit in memory.
+fn parse_repeats(s: &str) -> Result<usize, String> {
+    match s.trim().parse::<usize>() {
+        Ok(value @ 1..=1000) => Ok(value),
+        _ => Err(format!("expected a number of repetitions from 1 to 1000, got {s:?}")),
+    }
 }
 
 fn parse_aov(s: &str) -> Result<Aov, String> {

@@ -90,16 +90,22 @@ fn the_time_budget_stops_inside_a_costly_pass() {
         &dir.arg("o.png"),
     ]);
     let took = start.elapsed();
-    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(took < Duration::from_secs(5), "took {took:?}");
     let message = stderr(&out);
-    assert!(message.contains("time budget reached after 0 of"), "{message}");
-    assert!(message.contains("before the first pass completed"), "{message}");
+    assert!(
+        message.contains("time budget reached before the first pass completed, so nothing was written"),
+        "{message}"
+    );
+    // No pass, no image: a black one would have replaced the file.
+    assert!(!dir.path("o.png").exists());
 }
 
 #[test]
 fn ctrl_c_stops_inside_a_costly_pass() {
     let dir = TempDir::new("costly-signal");
+    // An image already there is kept: the interrupted render completed no pass to replace it with.
+    std::fs::write(dir.path("o.png"), b"an earlier render").unwrap();
     let child = lumiere()
         .args(["render", "--mode", "ao", "--samples", "5000000", "--size", "64x48", "-o", &dir.arg("o.png")])
         .stderr(Stdio::piped())
@@ -112,7 +118,12 @@ fn ctrl_c_stops_inside_a_costly_pass() {
     let out = child.wait_with_output().unwrap();
     assert!(sent.elapsed() < Duration::from_secs(5), "took {:?} to stop", sent.elapsed());
     assert_eq!(out.status.code(), Some(3), "{}", stderr(&out));
-    assert!(stderr(&out).contains("interrupted after 0 of 1 spp"), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("interrupted before the first pass completed: nothing was written"),
+        "{}",
+        stderr(&out)
+    );
+    assert_eq!(std::fs::read(dir.path("o.png")).unwrap(), b"an earlier render");
 }
 
 /// `--time` without `--spp` renders until the budget is met, not one pass.
@@ -158,6 +169,32 @@ fn assert_refused(dir: &TempDir, args: &[&str], expected: &str) {
     let after: Vec<(String, Vec<u8>)> =
         dir.entries().into_iter().map(|name| (name.clone(), fs::read(dir.path(&name)).unwrap_or_default())).collect();
     assert_eq!(before, after, "{args:?} changed the folder");
+}
+
+/// Refused before any work, and with a message instead of an abort: an AOV asked twice (an EXR
+/// cannot hold it), a benchmark's JSON that is not a `.json` file (`--json scene.obj` replaced the
+/// scene), repetitions whose times do not fit in memory, and more threads than `render` allows.
+#[test]
+fn bad_outputs_and_counts_are_refused_before_the_work() {
+    let dir = TempDir::new("refused-early");
+    let exr = dir.arg("o.exr");
+    assert_refused(
+        &dir,
+        &["render", "--size", "8x6", "--aov", "albedo,depth,albedo", "-o", &exr],
+        "--aov albedo is given twice",
+    );
+    fs::write(dir.path("scene.obj"), "v 0 0 0\n").unwrap();
+    for (args, expected) in [
+        (vec!["bench", "--quick", "--json", &dir.arg("scene.obj")], "expected a .json file name"),
+        (vec!["bench", "--repeats", "4294967296"], "from 1 to 1000"),
+        (vec!["bench", "--repeats", "0"], "from 1 to 1000"),
+        (vec!["bench-bvh", "--scenes", "cornell", "--threads", "100000"], "at most 1024 threads"),
+    ] {
+        let out = run(&args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains(expected), "{args:?}: {}", stderr(&out));
+    }
+    assert_eq!(fs::read(dir.path("scene.obj")).unwrap(), b"v 0 0 0\n");
 }
 
 #[test]

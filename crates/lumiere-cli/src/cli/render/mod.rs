@@ -14,6 +14,7 @@ use std::time::Instant;
 use glam::Vec3;
 use lumiere::Result;
 use lumiere::accel::BuildPreset;
+use lumiere::error::{Error, shown_path};
 use lumiere::image_io::{ExrLayer, PngEncoding, PngStyle, Tonemap, write_exr_with_layers, write_image};
 use lumiere::render::aov::{Aov, render_aovs};
 use lumiere::render::film::Film;
@@ -67,6 +68,9 @@ fn render(args: &RenderArgs, threads: usize, denoiser: Option<&oidn::Oidn>) -> R
     report::warn_if_unlit(&world, &options);
     signals::rendering_starts();
     let output = render_passes(args, &world, &camera, &options, &fingerprints, film, stats)?;
+    if output.film.samples == 0 {
+        return nothing_rendered(args, &output);
+    }
     report::warn_if_black(&output);
     write_output(args, &world, &camera, &options, &output, denoiser)?;
     if let Some(path) = &args.checkpoint {
@@ -82,6 +86,24 @@ fn render(args: &RenderArgs, threads: usize, denoiser: Option<&oidn::Oidn>) -> R
         }
     }
     Ok(if output.stop == StopReason::Interrupted { EXIT_INTERRUPTED } else { 0 })
+}
+
+/// A render stopped before its first pass completed writes nothing: its image would be black and
+/// would replace whatever the output file held (and a checkpoint of no samples is worth nothing).
+/// Interrupted, it exits as interrupted; out of time, it is an error, since the image asked for
+/// was not made.
+fn nothing_rendered(args: &RenderArgs, output: &RenderOutput) -> Result<u8> {
+    let path = shown_path(&args.output);
+    if output.stop == StopReason::Interrupted {
+        output::warn(format_args!(
+            "interrupted before the first pass completed: nothing was written ({path} is left as it was)"
+        ));
+        return Ok(EXIT_INTERRUPTED);
+    }
+    Err(Error::invalid(format!(
+        "{path}: {} before the first pass completed, so nothing was written: one pass takes longer than --time; give more time or fewer --samples",
+        output.stop.describe()
+    )))
 }
 
 /// The scene file or the built-in scene, with `--emission` applied and load warnings shown.

@@ -25,6 +25,10 @@ struct Named<'a> {
 /// Refuses outputs that would clobber an input or each other, or that cannot be written; cleans
 /// stale temporaries beside them.
 pub fn check(args: &RenderArgs) -> Result<()> {
+    // An EXR cannot hold one channel name twice: refused now, not after the render.
+    if let Some(twice) = args.aov.iter().enumerate().find(|(i, aov)| args.aov[..*i].contains(aov)).map(|(_, a)| a) {
+        return Err(Error::invalid(format!("--aov {} is given twice", twice.name())));
+    }
     let mut outputs = vec![Named { flag: "-o", path: &args.output }];
     if let Some(path) = args.stats_json.as_deref().filter(|p| p.as_os_str() != STDOUT_ARG) {
         outputs.push(Named { flag: "--stats-json", path });

@@ -8,7 +8,7 @@ use std::path::Path;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use lumiere::integrators::{AmbientOcclusion, Direct, Technique};
-use lumiere::render::{RenderOptions, RenderOutput, StopReason};
+use lumiere::render::{RenderOptions, RenderOutput};
 use lumiere::scene::camera::Camera;
 use lumiere::world::World;
 use lumiere::{Error, Result};
@@ -51,11 +51,6 @@ pub fn summary(options: &RenderOptions, camera: &Camera, output: &RenderOutput, 
         output.stats.mrays_per_second(),
         shown_path(path)
     ));
-    if output.film.samples == 0 && output.stop == StopReason::TimeBudget {
-        output::warn(
-            "the time budget ran out before the first pass completed, so the image is black: one pass takes longer than --time; give more time or fewer --samples",
-        );
-    }
     if output.film.discarded > 0 {
         output::warn(format_args!("{} non-finite or negative samples were discarded", output.film.discarded));
     }
