@@ -95,8 +95,10 @@ pub fn write_image(path: &Path, width: u32, height: u32, pixels: &[Vec3], png: i
 /// Checks before a long render that `path` has a supported extension and its directory exists and is writable
 /// (create and delete a probe temp file), so a render does not run for minutes and then fail.
 pub fn check_output_path(path: &Path) -> Result<()> {
-    format_of(path)?;
-    check_writable(path)
+    // The target's kind first: a folder (`-o renders/`) is named as one, not as a name without
+    // an extension.
+    check_writable(path)?;
+    format_of(path).map(|_| ())
 }
 
 /// sRGB encoding of one linear channel to 8 bits (IEC 61966-2-1), clamped; NaN -> 0.
@@ -188,10 +190,6 @@ fn format_of(path: &Path) -> Result<Format> {
             "{}: .{other} is not an image format lumiere writes (supported: {SUPPORTED})",
             shown_path(path)
         ))),
-        // A folder (`-o renders/`) is named as one, as the writer names it.
-        None if path.is_dir() => {
-            Err(Error::invalid(format!("{}: is a directory, expected a file name", shown_path(path))))
-        }
         None => Err(Error::invalid(format!(
             "{}: the file name has no extension, so the image format is unknown (supported: {SUPPORTED})",
             shown_path(path)

@@ -62,11 +62,8 @@ impl Scene {
             return Err(Error::invalid(format!("{name}: vertex index {bad} out of range")));
         }
         // The loaders check these already; scenes made from arrays (Python) are checked here.
-        if let Some(bad) = materials.iter().find(|m| !(m.ke.is_finite() && m.ke.min_element() >= 0.0)) {
-            return Err(Error::invalid(format!(
-                "{name}: material '{}': emission {} {} {} must be finite and not negative",
-                bad.name, bad.ke.x, bad.ke.y, bad.ke.z
-            )));
+        for material in &materials {
+            check_emission(&name, &material.name, material.ke)?;
         }
         if let Some(bad) = materials.iter().find(|m| !m.kd.is_finite()) {
             return Err(Error::invalid(format!(
@@ -82,12 +79,7 @@ impl Scene {
 
     /// Sets the emission of every material called `name`.
     pub fn set_emission(&mut self, name: &str, emission: Vec3) -> Result<()> {
-        if !(emission.is_finite() && emission.min_element() >= 0.0) {
-            return Err(Error::invalid(format!(
-                "{}: material '{name}': emission {} {} {} must be finite and not negative",
-                self.name, emission.x, emission.y, emission.z
-            )));
-        }
+        check_emission(&self.name, name, emission)?;
         let mut found = false;
         for material in self.materials.iter_mut().filter(|m| m.name == name) {
             material.ke = emission;
@@ -108,4 +100,16 @@ impl Scene {
     pub fn material(&self, id: u32) -> &Material {
         &self.materials[self.mesh.material_ids[id as usize] as usize]
     }
+}
+
+/// Refuses an emission that is negative or not finite (the light table's weights would be
+/// meaningless), naming the scene and the material: from files, from arrays or from `--emission`.
+fn check_emission(scene: &str, material: &str, ke: Vec3) -> Result<()> {
+    if ke.is_finite() && ke.min_element() >= 0.0 {
+        return Ok(());
+    }
+    Err(Error::invalid(format!(
+        "{scene}: material '{material}': emission {} {} {} must be finite and not negative",
+        ke.x, ke.y, ke.z
+    )))
 }
