@@ -167,13 +167,14 @@ impl World {
         matches!(self.kinds[material as usize], MaterialKind::Lambert).then(|| self.base_colour(material, uv))
     }
 
-    /// Material `material`'s colour at `uv`: its texture's there, or its `Kd`.
+    /// Material `material`'s colour at `uv`: its texture's there (placed by its `-s` and `-o`), or its `Kd`.
     #[inline]
     fn base_colour(&self, material: u32, uv: Vec2) -> Vec3 {
         let id = material as usize;
+        let material = &self.scene.materials[id];
         match self.texture_of_material[id] {
-            Some(texture) => self.textures.sample(texture, uv),
-            None => self.scene.materials[id].kd,
+            Some(texture) => self.textures.sample(texture, material.map_kd_transform.apply(uv)),
+            None => material.kd,
         }
     }
 
@@ -211,8 +212,9 @@ impl World {
         if !self.prefetches {
             return;
         }
-        if let Some(texture) = self.texture_of_material[surface.material as usize] {
-            self.textures.prefetch(texture, surface.uv);
+        let id = surface.material as usize;
+        if let Some(texture) = self.texture_of_material[id] {
+            self.textures.prefetch(texture, self.scene.materials[id].map_kd_transform.apply(surface.uv));
         }
     }
 
@@ -289,6 +291,7 @@ impl World {
         let material = self.scene.mesh.material_ids[id as usize] as usize;
         let Some(texture) = self.cutout_of_material[material] else { return true };
         let uv = self.interpolated_texcoord(id as usize, 1.0 - u - v, u, v);
+        let uv = self.scene.materials[material].map_d_transform.apply(uv);
         self.cutouts.get(texture).sample_coverage(uv) >= 0.5
     }
 

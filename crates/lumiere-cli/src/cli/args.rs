@@ -169,7 +169,9 @@ pub struct RenderArgs {
     /// Camera samples per pixel, each a pass over the image: 1 is one ray through each pixel centre
     /// (the lab's images), more are jittered in the pixel. [default: 8 for path, 1 for the lab's
     /// modes, or unlimited with --time or --noise: the render goes on until the budget is met]
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    // 2^32 - 1 is the library's "until a budget stops it" (`RenderOptions::spp`), which leaving
+    // --spp out asks for; as a number it would render without end.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(u32::MAX - 1)))]
     pub spp: Option<u32>,
 
     /// Random number generator for the Monte Carlo modes. [default: sobol for path (about half

@@ -9,6 +9,7 @@ use glam::Vec3;
 use lumiere::Result;
 use lumiere::lights::LightSet;
 use lumiere::materials::{Material, MaterialKind};
+use lumiere::math::UvTransform;
 use lumiere::scene::Scene;
 
 use super::args::InfoArgs;
@@ -79,16 +80,25 @@ fn describe(material: &Material) -> String {
     if !matches!(kind, MaterialKind::Mirror { .. } | MaterialKind::Dielectric { .. }) {
         parts.push(format!("Kd {}", vector(material.kd)));
         if let Some(texture) = &material.map_kd {
-            parts.push(format!("map_Kd {:?}", texture.display().to_string()));
+            parts.push(format!("map_Kd {}{:?}", placement(material.map_kd_transform), texture.display().to_string()));
         }
     }
     if let Some(mask) = &material.map_d {
-        parts.push(format!("map_d {:?} (cutout)", mask.display().to_string()));
+        parts.push(format!("map_d {}{:?} (cutout)", placement(material.map_d_transform), mask.display().to_string()));
     }
     if material.is_emissive() {
         parts.push(format!("Ke {} (a light)", vector(material.ke)));
     }
     parts.join(", ")
+}
+
+/// A texture's `-s` and `-o` as the MTL writes them, where they move it.
+fn placement(transform: UvTransform) -> String {
+    if transform.is_identity() {
+        return String::new();
+    }
+    let (s, o) = (transform.scale, transform.offset);
+    format!("-s {} {} -o {} {} ", number(s.x), number(s.y), number(o.x), number(o.y))
 }
 
 /// Six decimals, and `0` never printed as `-0`.

@@ -260,8 +260,10 @@ fn long_output_names_are_written() {
 
 #[test]
 fn numeric_flags_out_of_range_are_refused() {
-    let cases: [(&[&str], &str); 11] = [
+    let cases: [(&[&str], &str); 12] = [
         (&["--fov", "0"], "between 0 and 180"),
+        // The library's "unlimited": it would render without end.
+        (&["--spp", "4294967295"], "not in 1..=4294967294"),
         (&["--fov", "1e40"], "between 0 and 180"),
         (&["--fov", "nan"], "finite"),
         (&["--threads", "10000"], "at most 1024 threads"),
@@ -443,4 +445,34 @@ fn info_names_materials_and_prints_no_negative_zero() {
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("lights     0 triangles, area 0.000000"), "{text}");
     assert!(!text.contains("-0.000000"), "{text}");
+}
+
+/// An existing output that its owner made read-only is refused and kept, as `cp` would refuse to
+/// write into it (the atomic rename alone would replace it). Root may write into any file, so
+/// when the tests run as root the binary runs as an unprivileged user.
+#[test]
+#[cfg(unix)]
+fn a_read_only_output_is_refused_and_kept() {
+    use std::os::unix::fs::{MetadataExt, PermissionsExt};
+    use std::os::unix::process::CommandExt;
+    let dir = TempDir::new("read-only");
+    fs::set_permissions(&dir.0, fs::Permissions::from_mode(0o777)).unwrap();
+    let target = dir.write("kept.png", b"precious");
+    let render = |mode: u32| {
+        fs::set_permissions(&target, fs::Permissions::from_mode(mode)).unwrap();
+        let mut command = lumiere();
+        if fs::metadata("/proc/self").is_ok_and(|m| m.uid() == 0) {
+            command.uid(65534).gid(65534);
+        }
+        command.args(["render", "--mode", "hits", "--size", "8x6", "-o", &dir.arg("kept.png")]).output().unwrap()
+    };
+    let out = render(0o444);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("kept.png: exists and is read-only"), "{}", stderr(&out));
+    assert_eq!(fs::read(&target).unwrap(), b"precious");
+    assert_eq!(dir.entries(), ["kept.png"]);
+    // Writable, it is replaced: the refusal above came from the permission alone.
+    let out = render(0o666);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_ne!(fs::read(&target).unwrap(), b"precious");
 }

@@ -240,6 +240,27 @@ fn resuming_with_other_inputs_or_a_broken_file_is_refused() {
     assert!(stderr(&run).contains("not a valid lumiere checkpoint"), "{}", stderr(&run));
 }
 
+/// A checkpoint that already holds more samples than `--spp` asks for is resumed with a warning
+/// that the image keeps them all (samples cannot be taken out of a film), and the image is the
+/// checkpoint's.
+#[test]
+fn resuming_with_fewer_spp_warns_and_keeps_the_checkpoints_samples() {
+    let dir = TempDir::new("fewer");
+    let checkpoint = dir.arg("c.ckpt");
+    let base = ["render", "--mode", "ao", "--samples", "4", "--size", "16x12"];
+    let run = lumiere(&[&base[..], &["--spp", "4", "--checkpoint", &checkpoint, "-o", &dir.arg("a.pfm")]].concat());
+    assert!(run.status.success(), "{}", stderr(&run));
+    let run = lumiere(&[&base[..], &["--spp", "2", "--resume", &checkpoint, "-o", &dir.arg("b.pfm")]].concat());
+    assert!(run.status.success(), "{}", stderr(&run));
+    assert!(
+        stderr(&run)
+            .contains("c.ckpt already holds 4 spp, more than --spp 2: nothing is added, and the image keeps all 4"),
+        "{}",
+        stderr(&run)
+    );
+    assert_eq!(fs::read(dir.path("a.pfm")).unwrap(), fs::read(dir.path("b.pfm")).unwrap());
+}
+
 #[test]
 fn absurd_sizes_are_refused_before_allocating() {
     for size in ["100000x100000", "4294967295x4294967295"] {

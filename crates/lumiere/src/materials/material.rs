@@ -9,6 +9,7 @@ use glam::Vec3;
 use super::conductor::is_smooth;
 use super::microfacet::MIN_ALPHA;
 use super::{Conductor, Dielectric, Lambert, MaterialBsdf, Mirror, Plastic};
+use crate::math::UvTransform;
 use std::path::PathBuf;
 
 /// The index of refraction of a transmissive material whose file gives none usable (ordinary
@@ -42,9 +43,13 @@ pub struct Material {
     /// Diffuse texture, resolved relative to the MTL file; where it decodes, its value at the hit
     /// replaces `kd` as the base colour.
     pub map_kd: Option<PathBuf>,
+    /// Where `map_kd` lies on the surface (its `-s` and `-o` options).
+    pub map_kd_transform: UvTransform,
     /// Coverage texture (MTL `map_d`), resolved relative to the MTL file: where its coverage is
     /// below one half the surface is cut out (rays pass through it), as leaves and fences are drawn.
     pub map_d: Option<PathBuf>,
+    /// Where `map_d` lies on the surface (its `-s` and `-o` options).
+    pub map_d_transform: UvTransform,
     /// Index of refraction (MTL `Ni`) of a transmissive material.
     pub ni: f32,
     /// Opacity (`d`, or `1 − Tr`), 1 = opaque. Below 1 together with an explicit `Ni`, the surface
@@ -129,7 +134,9 @@ impl Material {
             ns: 0.0,
             ke: Vec3::ZERO,
             map_kd: None,
+            map_kd_transform: UvTransform::default(),
             map_d: None,
+            map_d_transform: UvTransform::default(),
             ni: 1.0,
             dissolve: 1.0,
             illum: 1,

@@ -32,6 +32,13 @@ pub fn scene_fingerprint(scene: &Scene) -> u64 {
             h.write(b"map_d");
             h.write(map_d.as_os_str().as_encoded_bytes());
         }
+        // The same for the textures' placements, hashed only where they move a texture.
+        for (key, transform) in [(&b"map_kd -s -o"[..], m.map_kd_transform), (&b"map_d -s -o"[..], m.map_d_transform)] {
+            if !transform.is_identity() {
+                h.write(key);
+                h.write_f32s([transform.scale, transform.offset].iter().flat_map(|v| v.to_array()));
+            }
+        }
     }
     h.finish()
 }

@@ -117,7 +117,30 @@ fn check_target(path: &Path) -> Result<()> {
             shown_path(path)
         )));
     }
+    // The rename would replace a file its owner made read-only, where writing into it would fail
+    // (as `cp` fails): refuse, as any other writer would.
+    if !may_write(path) {
+        return Err(Error::invalid(format!(
+            "{}: exists and is read-only (no write permission); lumiere does not replace it",
+            shown_path(path)
+        )));
+    }
     Ok(())
+}
+
+/// Whether this process may write into the existing file `path`, as `access(2)` says (root may
+/// write into any regular file on a writable file system).
+#[cfg(unix)]
+fn may_write(path: &Path) -> bool {
+    use std::os::unix::ffi::OsStrExt;
+    let Ok(name) = std::ffi::CString::new(path.as_os_str().as_bytes()) else { return true };
+    // SAFETY: `name` is a NUL-terminated string that outlives the call.
+    unsafe { libc::access(name.as_ptr(), libc::W_OK) == 0 }
+}
+
+#[cfg(not(unix))]
+fn may_write(path: &Path) -> bool {
+    fs::metadata(path).is_ok_and(|metadata| !metadata.permissions().readonly())
 }
 
 /// `.lumiere-<pid>-<n>.tmp` next to `path`: the same directory keeps the final rename atomic (no

@@ -187,6 +187,23 @@ fn rays_pass_where_the_coverage_is_below_one_half() {
 }
 
 #[test]
+fn the_mask_moves_with_its_placement() {
+    let dir = TempDir::new("cutout-placed");
+    let half = grey_mask(&dir, "half.png", &[0, 255]);
+    let mut placed = scene(Some(half), false);
+    // `map_d -o 0.5 0 half.png`: the blocker reads its mask half a turn along u.
+    placed.materials[2].map_d_transform.offset = Vec2::new(0.5, 0.0);
+    for isa in Isa::supported() {
+        let world = World::with_isa(placed.clone(), BuildPreset::Default, isa);
+        // As at u + 1/2 unplaced: 0.2 -> 0.7 (coverage 0.7), 0.3 -> 0.8 (0.9), 0.8 -> 0.3 (0.1),
+        // 0.55 -> 0.05 (0.4).
+        for (u, expected) in [(0.2, false), (0.3, false), (0.8, true), (0.55, true)] {
+            assert_eq!(passes_at(&world, u), expected, "{isa}: u = {u}");
+        }
+    }
+}
+
+#[test]
 fn map_d_resolves_next_to_the_mtl_and_a_missing_file_leaves_the_surface_opaque() {
     let dir = TempDir::new("cutout-mtl");
     std::fs::create_dir_all(dir.path("masks")).unwrap();

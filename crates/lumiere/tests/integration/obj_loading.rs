@@ -5,6 +5,7 @@ use crate::common::TempDir;
 use flate2::Compression;
 use flate2::write::GzEncoder;
 use glam::{Vec2, Vec3};
+use lumiere::math::UvTransform;
 use lumiere::scene::load::obj::{ObjScene, load_obj, parse_obj, parse_obj_with_chunk_size};
 use lumiere::scene::mesh::NO_INDEX;
 use std::io::{self, Write};
@@ -112,11 +113,53 @@ fn attribute_lists_are_empty_without_attributes() {
 
 #[test]
 fn ignored_statements_and_empty_file() {
-    let text = format!("o thing\ng a b\ns off\n{SQUARE}l 1 2\np 3\nvp 0.5\ncurv 0 1 1 2\nf 1 2 3\n");
-    assert_eq!(parse(&text).mesh.triangle_count(), 1);
+    let text = format!("o thing\ng a b\ns off\nmg 1\n{SQUARE}vp 0.5\ncstype bspline\nf 1 2 3 # the face\n# end\n\n");
+    let scene = parse(&text);
+    assert_eq!(scene.mesh.triangle_count(), 1);
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
     let empty = parse("");
     assert_eq!(empty.mesh.triangle_count(), 0);
     assert!(empty.materials.is_empty() && empty.warnings.is_empty());
+}
+
+/// Elements lumiere does not render and keywords that are not OBJ get one warning per keyword,
+/// with their count and first line, whatever the chunks; the scene's faces still load.
+#[test]
+fn skipped_statements_are_named_once_per_keyword() {
+    let text = format!("{SQUARE}l 1 2\nfoo 1\nl 2 3\np 3\nf 1 2 3\nfoo 2\ncurv 0 1 1 2\n");
+    let read = mtl_files(&[]);
+    let name = Path::new("test.obj");
+    let single = parse_obj_with_chunk_size(text.as_bytes(), name, &read, usize::MAX).expect("parses");
+    assert_eq!(single.mesh.triangle_count(), 1);
+    let expected = [
+        "test.obj:5: \"l\" statements (polylines) are not rendered: 2 lines ignored, the first on this line",
+        "test.obj:6: unknown statement \"foo\": 2 lines ignored, the first on this line",
+        "test.obj:8: \"p\" statements (points) are not rendered: 1 line ignored, the first on this line",
+        "test.obj:11: \"curv\" statements (free-form curves) are not rendered: 1 line ignored, the first on this line",
+    ];
+    assert_eq!(single.warnings, expected);
+    for chunk in [1, 9] {
+        let chunked = parse_obj_with_chunk_size(text.as_bytes(), name, &read, chunk).expect("parses");
+        assert_eq!(chunked.warnings, expected, "chunk {chunk}");
+    }
+    // A file of many junk keywords: a few warnings, every line counted.
+    let junk: String = (0..100).map(|k| format!("junk{k} x\n")).collect();
+    let scene = parse(&format!("{SQUARE}f 1 2 3\n{junk}"));
+    assert!(scene.warnings.len() <= 12, "{:?}", scene.warnings);
+    assert!(scene.warnings.iter().any(|w| w.contains("more like this") || w.contains("more with other")));
+}
+
+/// Binary data under an `.obj` name, or text with no face and no OBJ statement, is refused with
+/// the line that gave it away, instead of loading as an empty scene.
+#[test]
+fn files_that_are_not_obj_are_refused() {
+    assert_error(b"ply\nformat binary_little_endian 1.0\nend_header\n\x00\x00\x80?\n", 4, "NUL byte");
+    assert_error(b"# a comment with \x00 in it\nv 0 0 0\n", 1, "not an OBJ text file");
+    assert_error(b"\x1f\x8b\x08\x00\x00\x00", 1, "NUL byte");
+    assert_error(b"hello world\nthis is prose\n", 1, "unknown statement \"hello\" and not one face");
+    // Unknown statements beside faces are only warned about; elements without faces too.
+    assert_eq!(parse(&format!("hello\n{SQUARE}f 1 2 3\n")).mesh.triangle_count(), 1);
+    assert_eq!(parse(&format!("{SQUARE}l 1 2 3\n")).warnings.len(), 1);
 }
 
 #[test]
@@ -200,7 +243,7 @@ fn mtl_statements_and_texture_paths() {
     assert_eq!(scene.warnings.len(), 2, "{:?}", scene.warnings);
     assert!(
         scene.warnings[0]
-            .contains("material \"glass\" uses statements lumiere does not render: \"map_Kd -bm -o\", \"map_Bump\""),
+            .contains("material \"glass\" uses statements lumiere does not render: \"map_Kd -bm\", \"map_Bump\""),
         "{:?}",
         scene.warnings
     );
@@ -214,12 +257,40 @@ fn mtl_statements_and_texture_paths() {
     assert_eq!(scene.materials[1].dissolve, 0.5);
 }
 
+/// Texture options take the values the MTL specification gives them, so the file is the rest of
+/// the line, spaces included; `-s` and `-o` place the texture, the others are named once.
+#[test]
+fn texture_options_and_file_names_with_spaces() {
+    let mtl = "newmtl tiles\nmap_Kd -s 4 2 1 -o 0.5 0.25 -clamp off -blendu on -imfchan r my wood tiles.png\n\
+               newmtl one\nmap_Kd -s 3 -o -0.5 tile.jpg # the tile\n\
+               newmtl odd\nmap_d -foo 2 3 -mm 0 1 cut out.png\n\
+               newmtl plain\nmap_Kd plain.png\n\
+               newmtl broken\nmap_Kd -s\nmap_d -mm 1 x.png\n";
+    let scene = parse_with(&format!("mtllib t.mtl\n{SQUARE}usemtl tiles\nf 1 2 3\n"), &[("t.mtl", mtl)]);
+    let [tiles, one, odd, plain, broken] = &scene.materials[..] else { panic!("{:?}", scene.materials) };
+    assert_eq!(tiles.map_kd.as_deref(), Some(Path::new("mem/my wood tiles.png")));
+    assert_eq!(tiles.map_kd_transform, UvTransform { scale: Vec2::new(4.0, 2.0), offset: Vec2::new(0.5, 0.25) });
+    assert_eq!(one.map_kd.as_deref(), Some(Path::new("mem/tile.jpg")));
+    assert_eq!(one.map_kd_transform, UvTransform { scale: Vec2::new(3.0, 1.0), offset: Vec2::new(-0.5, 0.0) });
+    assert_eq!(odd.map_d.as_deref(), Some(Path::new("mem/cut out.png")));
+    assert!(odd.map_d_transform.is_identity() && plain.map_kd_transform.is_identity());
+    assert_eq!(plain.map_kd.as_deref(), Some(Path::new("mem/plain.png")));
+    assert!(broken.map_kd.is_none() && broken.map_d.is_none());
+    let expected = [
+        "mem/t.mtl:10: map_Kd -s: expected 1 value(s), found 0; line ignored",
+        "mem/t.mtl:11: map_d -mm: expected 2 value(s), found 1; line ignored",
+        "mem/t.mtl: material \"tiles\" uses statements lumiere does not render: \"map_Kd -blendu -imfchan\" (see docs/MATERIALS.md)",
+        "mem/t.mtl: material \"odd\" uses statements lumiere does not render: \"map_d -foo -mm\" (see docs/MATERIALS.md)",
+    ];
+    assert_eq!(scene.warnings, expected);
+}
+
 #[test]
 fn values_without_effect_are_named_in_the_material_warning() {
     let mtl = "newmtl tinted\nKd 0.5 0.5 0.5\nTf 1 0 0\n\
                newmtl veil\nd 0.5\n\
                newmtl matte\nillum 10\n\
-               newmtl scaled\nmap_Kd -s 2 2 1 -clamp off wood.png\n\
+               newmtl scaled\nmap_Kd -s 2 2 1 -clamp on wood.png\n\
                newmtl fine\nillum 7\nTf 1 0 0\nd 0.5\nmap_d -clamp off leaf.png\n\
                newmtl leaf\nd 0.5\nmap_d leaf.png\n";
     let scene = parse_with(&format!("mtllib m.mtl\n{SQUARE}usemtl fine\nf 1 2 3\n"), &[("m.mtl", mtl)]);
@@ -227,7 +298,7 @@ fn values_without_effect_are_named_in_the_material_warning() {
         ("tinted", "\"Tf\" (only glass filters light)"),
         ("veil", "\"d\" below 1 without \"Ni\""),
         ("matte", "\"illum 10\""),
-        ("scaled", "\"map_Kd -s\""),
+        ("scaled", "\"map_Kd -clamp\""),
     ];
     assert_eq!(scene.warnings.len(), expected.len(), "{:#?}", scene.warnings);
     for ((name, what), warning) in expected.iter().zip(&scene.warnings) {

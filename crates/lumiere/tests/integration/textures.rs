@@ -285,3 +285,48 @@ fn coverage_is_the_alpha_or_the_stored_grey_at_either_depth() {
     RgbImage::from_fn(1, 1, |_, _| Rgb([255, 0, 0])).save_with_format(&colour, ImageFormat::Png).unwrap();
     assert!((load_one(&colour).sample_coverage(Vec2::splat(0.5)) - 0.2126).abs() < 1e-6);
 }
+
+/// A diffuse texture's `-s` and `-o` (MTL) move where the surface reads it, through everything
+/// that shades (`World::lambert_reflectance` and `World::bsdf` share the lookup): `uv · s + o`.
+#[test]
+fn texture_placement_scales_and_offsets_the_lookup() {
+    use lumiere::accel::BuildPreset;
+    use lumiere::materials::Material;
+    use lumiere::math::UvTransform;
+    use lumiere::scene::Scene;
+    use lumiere::scene::mesh::TriangleMesh;
+    use lumiere::world::World;
+
+    let dir = TempDir::new("texture-placement");
+    let path = dir.path("four.png");
+    test_image().save_with_format(&path, ImageFormat::Png).unwrap();
+    let texture = load_one(&path);
+    let mesh = TriangleMesh {
+        positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+        indices: vec![[0, 1, 2]],
+        material_ids: vec![0],
+        ..Default::default()
+    };
+    let placements = [
+        UvTransform::default(),
+        UvTransform { scale: Vec2::new(2.0, 3.0), offset: Vec2::ZERO },
+        UvTransform { scale: Vec2::ONE, offset: Vec2::new(0.25, -1.0 / 3.0) },
+        UvTransform { scale: Vec2::new(-1.0, 0.5), offset: Vec2::new(0.125, 0.5) },
+    ];
+    for placement in placements {
+        let material =
+            Material { map_kd: Some(path.clone()), map_kd_transform: placement, ..Material::default_grey("t") };
+        let scene = Scene::from_parts("placed".into(), mesh.clone(), vec![material], vec![]).unwrap();
+        let world = World::new(scene, BuildPreset::Default);
+        for (x, y) in [(0, 0), (1, 2), (3, 1)] {
+            let uv = centre(x, y, 4, 3);
+            let got = world.lambert_reflectance(0, uv).expect("a diffuse material");
+            assert_eq!(got, texture.sample(uv * placement.scale + placement.offset), "{placement:?} at {uv}");
+        }
+    }
+    // The comparison can fail: a shift by one texel reads another texel's colour.
+    let shifted = UvTransform { scale: Vec2::ONE, offset: Vec2::new(0.25, 0.0) };
+    let uv = centre(1, 1, 4, 3);
+    assert!(!close(texture.sample(shifted.apply(uv)), texture.sample(uv), 1e-3));
+    assert!(close(texture.sample(shifted.apply(uv)), texture.sample(centre(2, 1, 4, 3)), 1e-6));
+}

@@ -52,7 +52,7 @@ impl Fingerprints {
         if checkpoint.options_fingerprint != hash_bytes(self.options.as_bytes()) || checkpoint.seed != self.seed {
             let differing = differing_options(&checkpoint.options, &self.options);
             return Err(Error::invalid(format!(
-                "{}: cannot resume: the checkpoint was rendered with other options: {}; only --spp and the budgets may change",
+                "{}: cannot resume: the checkpoint was rendered with other options: {}; only --spp, the budgets, --threads and the outputs may change",
                 shown_path(path),
                 differing.join(", ")
             )));

@@ -57,6 +57,16 @@ fn render(args: &RenderArgs, threads: usize, denoiser: Option<&oidn::Oidn>) -> R
     let options = options::from_args(args);
     let fingerprints = Fingerprints::new(&scene, &options, &camera);
     let (film, stats) = fingerprints.start(args.resume.as_deref(), &camera)?;
+    if let Some(resume) = args.resume.as_deref().filter(|_| film.samples > options.spp) {
+        // Samples cannot be taken back out of a film: say that the image will have them all.
+        output::warn(format_args!(
+            "{} already holds {} spp, more than --spp {}: nothing is added, and the image keeps all {}",
+            shown_path(resume),
+            film.samples,
+            options.spp,
+            film.samples
+        ));
+    }
 
     let build_start = Instant::now();
     let world = World::with_isa(scene, BuildPreset::Default, isa);

@@ -118,7 +118,66 @@ pub(super) struct ChunkMesh<'a> {
     pub(super) dropped_texcoords: Dropped,
     /// Faces with a normal index out of range (dropped for those corners).
     pub(super) dropped_normals: Dropped,
+    /// Statements skipped that a reader should hear about, by keyword, in order of first use.
+    pub(super) skipped: Vec<Skipped<'a>>,
+    /// Skipped lines whose keyword came after the chunk had kept [`SKIPPED_KEYWORDS`] others.
+    pub(super) skipped_others: usize,
 }
+
+/// The statements of one keyword that the parser skipped although they may carry content: elements
+/// lumiere does not render (`l`, `p`, free-form geometry) or a keyword that is not OBJ at all.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Skipped<'a> {
+    pub(super) keyword: &'a [u8],
+    pub(super) lines: usize,
+    pub(super) first_line: usize,
+}
+
+/// How many distinct skipped keywords a chunk keeps; past them a file of junk is only counted, so
+/// that its warnings stay few and its memory bounded.
+const SKIPPED_KEYWORDS: usize = 16;
+
+/// Keywords the parser skips without a word: grouping, smoothing and display attributes, and the
+/// parts of free-form geometry that mean nothing without the `curv`/`surf` statements (which are
+/// warned about).
+const SILENT: [&[u8]; 26] = [
+    b"o",
+    b"g",
+    b"s",
+    b"mg",
+    b"vp",
+    b"cstype",
+    b"deg",
+    b"bmat",
+    b"step",
+    b"parm",
+    b"trim",
+    b"hole",
+    b"scrv",
+    b"sp",
+    b"end",
+    b"con",
+    b"bevel",
+    b"c_interp",
+    b"d_interp",
+    b"lod",
+    b"usemap",
+    b"maplib",
+    b"shadow_obj",
+    b"trace_obj",
+    b"ctech",
+    b"stech",
+];
+
+/// Elements of the OBJ format that lumiere does not render, with what they are.
+pub(super) const UNRENDERED: [(&[u8], &str); 6] = [
+    (b"l", "polylines"),
+    (b"p", "points"),
+    (b"curv", "free-form curves"),
+    (b"curv2", "free-form curves"),
+    (b"surf", "free-form surfaces"),
+    (b"call", "calls to other files"),
+];
 
 /// Faces that lost an attribute index because it pointed at nothing.
 #[derive(Clone, Copy, Debug, Default)]
@@ -208,9 +267,31 @@ impl<'a> ChunkParser<'a> {
                 let names = tokens.remainder();
                 self.mesh.libraries.push(MaterialLibrary { line: line_number, names });
             }
-            _ => {}
+            Some(keyword) if SILENT.contains(&keyword) => {}
+            // Comments and blank lines too (`Tokens` ends a line at `#`).
+            keyword => {
+                // A NUL never occurs in text: this is some other format under an `.obj` name
+                // (a binary PLY, an archive), whose lines would otherwise load as nothing.
+                if line.contains(&0) {
+                    return Err("a NUL byte: binary data, not an OBJ text file".to_string());
+                }
+                if let Some(keyword) = keyword {
+                    self.skip(keyword, line_number);
+                }
+            }
         }
         Ok(())
+    }
+
+    fn skip(&mut self, keyword: &'a [u8], line: usize) {
+        let skipped = &mut self.mesh.skipped;
+        if let Some(known) = skipped.iter_mut().find(|s| s.keyword == keyword) {
+            known.lines += 1;
+        } else if skipped.len() < SKIPPED_KEYWORDS {
+            skipped.push(Skipped { keyword, lines: 1, first_line: line });
+        } else {
+            self.mesh.skipped_others += 1;
+        }
     }
 
     fn use_material(&mut self, tokens: Tokens<'a>, line: usize) -> Result<(), String> {

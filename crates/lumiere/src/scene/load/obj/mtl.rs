@@ -4,6 +4,7 @@
 use super::text::{Tokens, finite_f32, lines, quoted};
 use crate::error::{quote, shown_path};
 use crate::materials::{Material, MaterialKind};
+use crate::math::UvTransform;
 use crate::scene::load::warnings::Warnings;
 use glam::Vec3;
 use std::path::{Path, PathBuf};
@@ -105,9 +106,8 @@ enum Statement {
 }
 
 impl Statement {
-    /// The options of a texture statement that lumiere does not honour (`map_Kd -s 2 2 1 …`), as
-    /// `"map_Kd -s"`: they cost a warning, since scaling or offsetting a texture changes what a
-    /// surface looks like. `-clamp off` is the default, repeat wrapping, which lumiere does.
+    /// The options of a texture statement that lumiere does not honour (`map_Kd -bm 1 …`), as
+    /// `"map_Kd -bm"`: they cost a warning, since they change what a surface looks like.
     fn texture_option(&self) -> Option<String> {
         let (keyword, options) = match self {
             Statement::DiffuseMap(map) => ("map_Kd", &map.options),
@@ -127,8 +127,10 @@ impl Statement {
             Statement::RefractiveIndex(ni) => material.ni = ni,
             Statement::Dissolve(d) => material.dissolve = d,
             Statement::Illumination(illum) => material.illum = illum,
-            Statement::DiffuseMap(map) => material.map_kd = Some(map.path),
-            Statement::CoverageMap(map) => material.map_d = Some(map.path),
+            Statement::DiffuseMap(map) => {
+                (material.map_kd, material.map_kd_transform) = (Some(map.path), map.transform)
+            }
+            Statement::CoverageMap(map) => (material.map_d, material.map_d_transform) = (Some(map.path), map.transform),
             Statement::TransmissionFilter(tf) => material.tf = tf,
             Statement::Metallic(pm) => material.metallic = Some(pm),
             Statement::Roughness(pr) => material.roughness = Some(pr),
@@ -157,8 +159,8 @@ fn parse_statement(line: &[u8], folder: &Path) -> Result<Option<Statement>, Stri
         b"d" => Statement::Dissolve(scalar(tokens.skip_while(|&token| token == b"-halo"))?),
         b"Tr" => Statement::Dissolve(1.0 - scalar(tokens)?),
         b"illum" => Statement::Illumination(integer(tokens)?),
-        b"map_Kd" => Statement::DiffuseMap(texture_path("map_Kd", tokens, folder)?),
-        b"map_d" => Statement::CoverageMap(texture_path("map_d", tokens, folder)?),
+        b"map_Kd" => Statement::DiffuseMap(texture_map("map_Kd", tokens, folder)?),
+        b"map_d" => Statement::CoverageMap(texture_map("map_d", tokens, folder)?),
         b"Tf" => Statement::TransmissionFilter(color(tokens)?),
         b"Pm" => Statement::Metallic(scalar(tokens)?),
         b"Pr" => Statement::Roughness(scalar(tokens)?),
@@ -214,30 +216,77 @@ fn integer<'a>(mut tokens: impl Iterator<Item = &'a [u8]>) -> Result<u32, String
     }
 }
 
-/// A texture statement: the file, and the options written before it that lumiere ignores.
+/// A texture statement: the file, where it lies on the surface, and the options written before
+/// it that lumiere ignores.
 struct TextureMap {
     path: PathBuf,
+    transform: UvTransform,
     options: Vec<String>,
 }
 
-/// The texture file is the last token: options such as `-bm 1` or `-o 0 0 0` come before it, an
-/// option being a token that starts with `-` and is not a number. Backslashes become slashes,
-/// since files exported on Windows use them as separators.
-fn texture_path<'a>(
-    keyword: &str,
-    tokens: impl Iterator<Item = &'a [u8]>,
-    folder: &Path,
-) -> Result<TextureMap, String> {
-    let tokens: Vec<&[u8]> = tokens.collect();
-    let (file, before) = tokens.split_last().ok_or_else(|| format!("{keyword} without a file name"))?;
+/// How many values a texture option takes, at least and at most (the MTL specification): `-s`,
+/// `-o` and `-t` take one to three numbers (u, then optional v and w), `-mm` two, the others one.
+/// `None` for an option the specification does not have.
+fn option_values(option: &[u8]) -> Option<(usize, usize)> {
+    match option {
+        b"-s" | b"-o" | b"-t" => Some((1, 3)),
+        b"-mm" => Some((2, 2)),
+        b"-blendu" | b"-blendv" | b"-bm" | b"-boost" | b"-cc" | b"-clamp" | b"-imfchan" | b"-texres" | b"-type" => {
+            Some((1, 1))
+        }
+        _ => None,
+    }
+}
+
+/// Parses `[options] file`: options come first, each a token that starts with `-` and is not a
+/// number, with its values; the rest of the line, spaces included, is the file (Blender writes
+/// names with spaces unquoted). `-s` and `-o` place the texture (their u and v; w is for 3D
+/// textures); `-clamp off` is the default, repeat wrapping; the others are returned to be warned
+/// about. Backslashes become slashes, since files exported on Windows use them as separators.
+fn texture_map(keyword: &str, mut tokens: Tokens, folder: &Path) -> Result<TextureMap, String> {
+    let mut transform = UvTransform::default();
     let mut options = Vec::new();
-    for (k, token) in before.iter().enumerate() {
-        let is_option = token.starts_with(b"-") && finite_f32(token).is_err();
-        let default_wrap = *token == b"-clamp" && before.get(k + 1) == Some(&&b"off"[..]);
-        if is_option && !default_wrap {
-            options.push(String::from_utf8_lossy(token).into_owned());
+    loop {
+        let mut ahead = tokens.clone();
+        let Some(option) = ahead.next().filter(|t| t.starts_with(b"-") && finite_f32(t).is_err()) else { break };
+        tokens = ahead;
+        let shown = String::from_utf8_lossy(option).into_owned();
+        let values: Vec<&[u8]> = match option_values(option) {
+            Some((least, most)) => {
+                let numeric = !matches!(option, b"-blendu" | b"-blendv" | b"-cc" | b"-clamp" | b"-imfchan" | b"-type");
+                let mut values = Vec::new();
+                while values.len() < most {
+                    let mut ahead = tokens.clone();
+                    match ahead.next() {
+                        Some(value) if !numeric || finite_f32(value).is_ok() => values.push(value),
+                        _ => break,
+                    }
+                    tokens = ahead;
+                }
+                if values.len() < least {
+                    return Err(format!("{keyword} {shown}: expected {least} value(s), found {}", values.len()));
+                }
+                values
+            }
+            // An option unknown to the specification: its numbers go with it.
+            None => {
+                while tokens.clone().next().is_some_and(|t| finite_f32(t).is_ok()) {
+                    tokens.next();
+                }
+                Vec::new()
+            }
+        };
+        let number = |k: usize, default: f32| values.get(k).map_or(Ok(default), |v| finite_f32(v));
+        match option {
+            b"-s" => transform.scale = glam::Vec2::new(number(0, 1.0)?, number(1, 1.0)?),
+            b"-o" => transform.offset = glam::Vec2::new(number(0, 0.0)?, number(1, 0.0)?),
+            b"-clamp" if values == [b"off"] => {}
+            _ => options.push(shown),
         }
     }
-    let file = String::from_utf8_lossy(file).replace('\\', "/");
-    Ok(TextureMap { path: folder.join(file), options })
+    let file = tokens.remainder();
+    if file.is_empty() {
+        return Err(format!("{keyword} without a file name"));
+    }
+    Ok(TextureMap { path: folder.join(file.replace('\\', "/")), transform, options })
 }

@@ -15,7 +15,8 @@ pub(super) fn lines(bytes: &[u8]) -> impl Iterator<Item = &[u8]> {
 
 /// Whitespace-separated tokens of one line, without allocating. A token that starts with `#` ends
 /// the line: MTL files in the wild put comments after values (`Ka 0.7 0.7 0.7 # White`), while a
-/// `#` inside a token (`Material#1`) is kept.
+/// `#` inside a token (`Material#1`) is kept. Cloning one looks ahead.
+#[derive(Clone)]
 pub(super) struct Tokens<'a> {
     rest: &'a [u8],
 }
