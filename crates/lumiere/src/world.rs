@@ -11,8 +11,8 @@ use crate::geometry::surface::SurfacePoint;
 use crate::geometry::surface_lanes::{HitCorners, SurfaceRows};
 use crate::lights::LightSet;
 use crate::materials::{Material, MaterialBsdf, MaterialKind};
-use crate::math::Ray;
 use crate::math::rows::{Rows, set_row};
+use crate::math::{Ray, UvTransform};
 use crate::scene::Scene;
 use crate::scene::mesh::NO_INDEX;
 use crate::textures::{TextureId, TextureSet};
@@ -25,12 +25,13 @@ pub struct World {
     lights: LightSet,
     /// Each material's kind, mapped once from its statements.
     kinds: Vec<MaterialKind>,
-    /// Each material's diffuse texture, decoded once.
-    texture_of_material: Vec<Option<TextureId>>,
+    /// Each material's diffuse texture, decoded once, with its placement (`-s`, `-o`) where it
+    /// moves the texture: most scenes have none, and a lookup then costs what it did without.
+    texture_of_material: Vec<Option<(TextureId, Option<UvTransform>)>>,
     textures: TextureSet,
     /// Each material's coverage texture (`map_d`), decoded once: rays pass through its surface
     /// where the coverage is below one half ([`World::opaque_at`]).
-    cutout_of_material: Vec<Option<TextureId>>,
+    cutout_of_material: Vec<Option<(TextureId, Option<UvTransform>)>>,
     /// The coverage textures that decoded; without one (most scenes) every query goes straight
     /// to the BVH, its packets and batches (see [`World::has_cutouts`]).
     cutouts: TextureSet,
@@ -87,6 +88,7 @@ impl World {
         let kinds = scene.materials.iter().map(Material::kind).collect();
         let (texture_of_material, textures, mut warnings) =
             TextureSet::for_materials(scene.materials.iter().map(|m| m.map_kd.as_deref()));
+        let texture_of_material = placed(texture_of_material, scene.materials.iter().map(|m| m.map_kd_transform));
         // Lights are sampled over their whole triangles, so an emitter stays whole for the rays
         // that find it too: cut out, a BSDF-sampled ray would pass where light sampling adds
         // emission, and the two strategies would disagree.
@@ -96,6 +98,7 @@ impl World {
         let (cutout_of_material, cutouts, cutout_warnings) =
             TextureSet::for_cutouts(scene.materials.iter().map(|m| m.map_d.as_deref().filter(|_| !m.is_emissive())));
         warnings.extend(cutout_warnings);
+        let cutout_of_material = placed(cutout_of_material, scene.materials.iter().map(|m| m.map_d_transform));
         let diameter = scene.bounds().extent().length();
         let prefetches = scene.mesh.memory_bytes() + textures.memory_bytes() > PREFETCH_ABOVE_BYTES;
         World {
@@ -171,10 +174,9 @@ impl World {
     #[inline]
     fn base_colour(&self, material: u32, uv: Vec2) -> Vec3 {
         let id = material as usize;
-        let material = &self.scene.materials[id];
         match self.texture_of_material[id] {
-            Some(texture) => self.textures.sample(texture, material.map_kd_transform.apply(uv)),
-            None => material.kd,
+            Some((texture, placement)) => self.textures.sample(texture, placed_uv(placement, uv)),
+            None => self.scene.materials[id].kd,
         }
     }
 
@@ -212,9 +214,8 @@ impl World {
         if !self.prefetches {
             return;
         }
-        let id = surface.material as usize;
-        if let Some(texture) = self.texture_of_material[id] {
-            self.textures.prefetch(texture, self.scene.materials[id].map_kd_transform.apply(surface.uv));
+        if let Some((texture, placement)) = self.texture_of_material[surface.material as usize] {
+            self.textures.prefetch(texture, placed_uv(placement, surface.uv));
         }
     }
 
@@ -289,10 +290,9 @@ impl World {
     /// cutout leaves and fences.
     fn opaque_at(&self, id: u32, u: f32, v: f32) -> bool {
         let material = self.scene.mesh.material_ids[id as usize] as usize;
-        let Some(texture) = self.cutout_of_material[material] else { return true };
+        let Some((texture, placement)) = self.cutout_of_material[material] else { return true };
         let uv = self.interpolated_texcoord(id as usize, 1.0 - u - v, u, v);
-        let uv = self.scene.materials[material].map_d_transform.apply(uv);
-        self.cutouts.get(texture).sample_coverage(uv) >= 0.5
+        self.cutouts.get(texture).sample_coverage(placed_uv(placement, uv)) >= 0.5
     }
 
     /// Readies `batch` for `rays` rays leaving `origin` inside `region`: gathers their candidate
@@ -423,4 +423,19 @@ impl World {
     fn interpolated_texcoord(&self, id: usize, w: f32, u: f32, v: f32) -> Vec2 {
         self.scene.mesh.corner_texcoords(id).map_or(Vec2::ZERO, |[a, b, c]| w * a + u * b + v * c)
     }
+}
+
+/// Each material's texture id with that material's placement of it, where it moves the texture.
+fn placed(
+    ids: Vec<Option<TextureId>>,
+    placements: impl Iterator<Item = UvTransform>,
+) -> Vec<Option<(TextureId, Option<UvTransform>)>> {
+    let moved = placements.map(|placement| Some(placement).filter(|p| !p.is_identity()));
+    ids.into_iter().zip(moved).map(|(id, placement)| id.map(|id| (id, placement))).collect()
+}
+
+/// Where a texture placed by `placement` is read for the surface's `uv`.
+#[inline(always)]
+fn placed_uv(placement: Option<UvTransform>, uv: Vec2) -> Vec2 {
+    placement.map_or(uv, |p| p.apply(uv))
 }
