@@ -2,7 +2,10 @@
 //! their codes and decode them through a table at each lookup; alpha where the file has one), and
 //! looked up with bilinear filtering and repeat wrapping.
 //!
-//! * **Colour.** PNG and JPEG store sRGB-encoded values; each channel is decoded with the exact
+//! * **Files.** PNG, JPEG, BMP and TGA (8 or 16 bits per channel, grey or colour, with or
+//!   without alpha), recognised from their content (TGA, which has no signature, from its
+//!   extension).
+//! * **Colour.** These formats store sRGB-encoded values; each channel is decoded with the exact
 //!   sRGB curve (IEC 61966-2-1: linear below 0.04045, a 2.4 power above), so texture values are
 //!   reflectances, like `Kd`. Alpha is linear coverage and is kept as is, for cutouts (`map_d`,
 //!   [`Texture::sample_coverage`]).
@@ -111,16 +114,26 @@ impl Texels {
 }
 
 impl Texture {
-    /// Decodes a PNG or JPEG file's bytes (the format is recognised from its content), refusing
-    /// images of more than [`MAX_TEXELS`] texels from the header alone. The error is a short
-    /// reason, without the file name.
+    /// Decodes a PNG, JPEG or BMP file's bytes (the format is recognised from its content),
+    /// refusing images of more than [`MAX_TEXELS`] texels from the header alone. The error is a
+    /// short reason, without the file name.
     pub fn decode(bytes: &[u8]) -> Result<Texture, String> {
+        Texture::decode_named(bytes, None)
+    }
+
+    /// As [`Texture::decode`], for the bytes of the file `name`: a TGA file, whose format has no
+    /// signature to recognise, is known by its extension.
+    pub fn decode_named(bytes: &[u8], name: Option<&Path>) -> Result<Texture, String> {
         let reader = ImageReader::new(Cursor::new(bytes)).with_guessed_format().map_err(|e| e.to_string())?;
+        let named_tga =
+            name.and_then(|name| name.extension()).is_some_and(|extension| extension.eq_ignore_ascii_case("tga"));
         let format = match reader.format() {
-            Some(format @ (ImageFormat::Png | ImageFormat::Jpeg)) => format,
-            Some(other) => return Err(format!("{other:?} images are not supported (PNG and JPEG are)")),
-            None => return Err("not a PNG or JPEG image".to_string()),
+            Some(format @ (ImageFormat::Png | ImageFormat::Jpeg | ImageFormat::Bmp)) => format,
+            Some(other) => return Err(format!("{other:?} images are not supported (PNG, JPEG, BMP and TGA are)")),
+            None if named_tga => ImageFormat::Tga,
+            None => return Err("not a PNG, JPEG, BMP or TGA image".to_string()),
         };
+        let reader = ImageReader::with_format(Cursor::new(bytes), format);
         let (width, height) = reader.into_dimensions().map_err(|e| e.to_string())?;
         check_size(width, height)?;
         let mut reader = ImageReader::with_format(Cursor::new(bytes), format);
@@ -479,7 +492,7 @@ fn read_texture(path: &Path) -> Result<Texture, String> {
         return Err(format!("the file has {} bytes, over the limit of {MAX_FILE_BYTES}", metadata.len()));
     }
     let bytes = crate::util::read::read_regular_file(path).map_err(|e| e.to_string())?;
-    Texture::decode(&bytes)
+    Texture::decode_named(&bytes, Some(path))
 }
 
 #[cfg(test)]

@@ -1,4 +1,4 @@
-//! Textures: PNG and JPEG files written here with the `image` crate, decoded to linear values with
+//! Textures: PNG, JPEG, BMP and TGA files written here with the `image` crate, decoded to linear values with
 //! the exact sRGB curve, looked up bilinearly with repeat wrapping and OBJ's bottom-left origin;
 //! files that cannot be used cost one warning each and no texture.
 
@@ -61,6 +61,57 @@ fn png_texel_centres_read_the_srgb_decoded_values() {
     assert_eq!(srgb_to_linear(1.0), 1.0);
     assert!((srgb_to_linear(10.0 / 255.0) - 10.0 / 255.0 / 12.92).abs() < 1e-9);
     assert!((srgb_to_linear(128.0 / 255.0) - 0.215_860_5).abs() < 1e-6);
+}
+
+/// BMP and TGA (which exporters of older scenes write) decode to the same texels as the PNG of
+/// the same image: TGA run-length encoded or not, with or without alpha, bottom-up or top-down;
+/// a TGA is known by its extension only.
+#[test]
+fn bmp_and_tga_files_decode_to_the_png_texels() {
+    let dir = TempDir::new("textures-bmp-tga");
+    let image = test_image();
+    let png = dir.path("grid.png");
+    image.save_with_format(&png, ImageFormat::Png).unwrap();
+    let expected = load_one(&png);
+    let bmp = dir.path("grid.bmp");
+    image.save_with_format(&bmp, ImageFormat::Bmp).unwrap();
+    let tga = dir.path("grid.tga");
+    image.save_with_format(&tga, ImageFormat::Tga).unwrap();
+    let upper = dir.path("GRID-ALPHA.TGA");
+    RgbaImage::from_fn(4, 3, |x, y| {
+        let p = image.get_pixel(x, y).0;
+        Rgba([p[0], p[1], p[2], (x * 80) as u8])
+    })
+    .save_with_format(&upper, ImageFormat::Tga)
+    .unwrap();
+    // Uncompressed TGAs written by hand (the encoder writes run-length ones): an 18-byte header
+    // (type 2, 24 bits, no id, no colour map), then BGR rows, bottom-up as TGA's default, or
+    // top-down with bit 5 of the image descriptor set.
+    let uncompressed = |top_down: bool| {
+        let mut bytes = vec![0, 0, 2, 0, 0, 0, 0, 0, 0, 0, 0, 0, 4, 0, 3, 0, 24, if top_down { 0x20 } else { 0 }];
+        let rows: Vec<u32> = if top_down { (0..3).collect() } else { (0..3).rev().collect() };
+        for y in rows {
+            for x in 0..4 {
+                let [r, g, b] = image.get_pixel(x, y).0;
+                bytes.extend([b, g, r]);
+            }
+        }
+        bytes
+    };
+    let bottom_up = dir.write("bottom-up.tga", uncompressed(false));
+    let top_down = dir.write("top-down.tga", uncompressed(true));
+    for path in [&bmp, &tga, &upper, &bottom_up, &top_down] {
+        let texture = load_one(path);
+        assert_eq!((texture.width(), texture.height()), (4, 3), "{}", path.display());
+        for (x, y, _) in image.enumerate_pixels() {
+            assert_eq!(texture.texel(x, y), expected.texel(x, y), "{} texel ({x}, {y})", path.display());
+        }
+    }
+    assert!(load_one(&upper).has_alpha());
+    // Without its extension, a TGA is not recognised: one warning, no texture.
+    let unnamed = dir.write("grid.img", std::fs::read(&tga).unwrap());
+    let (set, warnings) = TextureSet::load(&[&unnamed]);
+    assert!(set.is_empty() && warnings[0].contains("not a PNG, JPEG, BMP or TGA image"), "{warnings:?}");
 }
 
 #[test]
@@ -236,10 +287,17 @@ fn absurd_image_sizes_are_refused_before_decoding() {
     chunk(&mut png, b"IDAT", &[]);
     chunk(&mut png, b"IEND", &[]);
     let path = dir.write("huge.png", png);
-    let (set, warnings) = TextureSet::load(&[&path]);
+    // A TGA header of 65535 × 65535 true-colour pixels, then nothing.
+    let mut tga = vec![0, 0, 2, 0, 0, 0, 0, 0, 0, 0, 0, 0];
+    tga.extend(65_535u16.to_le_bytes());
+    tga.extend(65_535u16.to_le_bytes());
+    tga.extend([24, 0]);
+    let huge_tga = dir.write("huge.tga", tga);
+    let (set, warnings) = TextureSet::load(&[&path, &huge_tga]);
     assert!(set.is_empty());
-    assert_eq!(warnings.len(), 1);
+    assert_eq!(warnings.len(), 2);
     assert!(warnings[0].contains("20000×20000") && warnings[0].contains(&MAX_TEXELS.to_string()), "{}", warnings[0]);
+    assert!(warnings[1].contains("65535×65535"), "{}", warnings[1]);
 }
 
 /// The staircase's textures, where `../shared` is present: all decode, each once.
@@ -329,4 +387,39 @@ fn texture_placement_scales_and_offsets_the_lookup() {
     let uv = centre(1, 1, 4, 3);
     assert!(!close(texture.sample(shifted.apply(uv)), texture.sample(uv), 1e-3));
     assert!(close(texture.sample(shifted.apply(uv)), texture.sample(centre(2, 1, 4, 3)), 1e-6));
+}
+
+/// A TGA has no signature, so any bytes named `.tga` reach its decoder: cut and corrupted files
+/// (and noise) give an error or an image, never a panic or a huge allocation.
+#[test]
+fn corrupt_tga_files_are_refused_without_panicking() {
+    let image = test_image();
+    let dir = TempDir::new("textures-tga-noise");
+    let good = dir.path("good.tga");
+    image.save_with_format(&good, ImageFormat::Tga).unwrap();
+    let good = std::fs::read(&good).unwrap();
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        state
+    };
+    let name = std::path::Path::new("noise.tga");
+    for case in 0..2000 {
+        let mut bytes = good.clone();
+        match case % 3 {
+            0 => bytes.truncate(next() as usize % good.len()),
+            1 => {
+                for _ in 0..1 + next() % 4 {
+                    let at = next() as usize % bytes.len();
+                    bytes[at] = next() as u8;
+                }
+            }
+            _ => bytes = (0..next() % 64).map(|_| next() as u8).collect(),
+        }
+        if let Ok(texture) = Texture::decode_named(&bytes, Some(name)) {
+            assert!(u64::from(texture.width()) * u64::from(texture.height()) <= MAX_TEXELS);
+        }
+    }
 }
