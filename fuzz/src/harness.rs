@@ -77,8 +77,9 @@ pub fn obj_using_mtl(mtl: &[u8]) -> Vec<u8> {
     let mut obj = b"mtllib fuzz.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".to_vec();
     for line in mtl.split(|&b| b == b'\n').take(16) {
         let name = line.trim_ascii_start().strip_prefix(b"newmtl").map(<[u8]>::trim_ascii);
-        // `usemtl` without a name is an OBJ error; such MTL lines only cost a warning.
-        if let Some(name) = name.filter(|name| name.first().is_some_and(|&b| b != b'#')) {
+        // `usemtl` without a name is an OBJ error, as is a NUL byte in an OBJ; such MTL lines
+        // only cost a warning.
+        if let Some(name) = name.filter(|name| name.first().is_some_and(|&b| b != b'#') && !name.contains(&0)) {
             obj.extend_from_slice(b"usemtl ");
             obj.extend_from_slice(name);
             obj.extend_from_slice(b"\nf 1 2 3\n");

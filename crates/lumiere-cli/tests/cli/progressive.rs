@@ -258,6 +258,7 @@ fn resuming_with_fewer_spp_warns_and_keeps_the_checkpoints_samples() {
         "{}",
         stderr(&run)
     );
+    assert!(stderr(&run).contains("all samples done after 4 of 4 spp"), "{}", stderr(&run));
     assert_eq!(fs::read(dir.path("a.pfm")).unwrap(), fs::read(dir.path("b.pfm")).unwrap());
 }
 

@@ -142,6 +142,17 @@ fn skipped_statements_are_named_once_per_keyword() {
         let chunked = parse_obj_with_chunk_size(text.as_bytes(), name, &read, chunk).expect("parses");
         assert_eq!(chunked.warnings, expected, "chunk {chunk}");
     }
+    // Twenty kinds before a keyword that comes back later: its count and first line do not
+    // depend on where the chunks are cut.
+    let kinds: String = (0..20).map(|k| format!("kind{k} x\n")).collect();
+    let text = format!("{SQUARE}f 1 2 3\n{kinds}call a.obj\n{}call b.obj\ncall c.obj\n", "# filler\n".repeat(50));
+    let single = parse_obj_with_chunk_size(text.as_bytes(), name, &read, usize::MAX).expect("parses");
+    let call = "test.obj:26: \"call\" statements (calls to other files) are not rendered: 3 lines ignored, the first on this line";
+    assert!(single.warnings.iter().any(|w| w == call), "{:?}", single.warnings);
+    for chunk in [1, 40, 300] {
+        let chunked = parse_obj_with_chunk_size(text.as_bytes(), name, &read, chunk).expect("parses");
+        assert_eq!(chunked.warnings, single.warnings, "chunk {chunk}");
+    }
     // A file of many junk keywords: a few warnings, every line counted.
     let junk: String = (0..100).map(|k| format!("junk{k} x\n")).collect();
     let scene = parse(&format!("{SQUARE}f 1 2 3\n{junk}"));
@@ -157,6 +168,16 @@ fn files_that_are_not_obj_are_refused() {
     assert_error(b"# a comment with \x00 in it\nv 0 0 0\n", 1, "not an OBJ text file");
     assert_error(b"\x1f\x8b\x08\x00\x00\x00", 1, "NUL byte");
     assert_error(b"hello world\nthis is prose\n", 1, "unknown statement \"hello\" and not one face");
+    // A NUL anywhere, in a statement the parser keeps or skips, or in a comment after one.
+    for (bytes, line) in [
+        (&b"v 0 0 0\no foo\x00bar\n"[..], 2),
+        (b"g \x00\x00\n", 1),
+        (b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 # \x00\n", 4),
+        (b"usemtl a\x00b\n", 1),
+        (b"mtllib a\x00b.mtl\n", 1),
+    ] {
+        assert_error(bytes, line, "NUL byte");
+    }
     // Unknown statements beside faces are only warned about; elements without faces too.
     assert_eq!(parse(&format!("hello\n{SQUARE}f 1 2 3\n")).mesh.triangle_count(), 1);
     assert_eq!(parse(&format!("{SQUARE}l 1 2 3\n")).warnings.len(), 1);
@@ -168,7 +189,8 @@ fn non_utf8_comments_and_names_are_tolerated() {
     bytes.extend_from_slice(SQUARE.as_bytes());
     bytes.extend_from_slice(b"usemtl mat\xff\nf 1 2 3\n");
     let scene = parse_obj(&bytes, Path::new("test.obj"), &mtl_files(&[])).expect("lenient parse");
-    assert_eq!(scene.materials[0].name, "mat\u{fffd}");
+    // Not UTF-8: read as Latin-1, byte for character.
+    assert_eq!(scene.materials[0].name, "mat\u{ff}");
 }
 
 #[test]
@@ -258,14 +280,15 @@ fn mtl_statements_and_texture_paths() {
 }
 
 /// Texture options take the values the MTL specification gives them, so the file is the rest of
-/// the line, spaces included; `-s` and `-o` place the texture, the others are named once.
+/// the line, spaces included; `-s` and `-o` place the texture, options that ask for what lumiere
+/// does anyway pass silently, the others are named once each.
 #[test]
 fn texture_options_and_file_names_with_spaces() {
-    let mtl = "newmtl tiles\nmap_Kd -s 4 2 1 -o 0.5 0.25 -clamp off -blendu on -imfchan r my wood tiles.png\n\
+    let mtl = "newmtl tiles\nmap_Kd -s 4 2 1 -o 0.5 0.25 -clamp OFF -blendu on -cc off -imfchan r my wood tiles.png\n\
                newmtl one\nmap_Kd -s 3 -o -0.5 tile.jpg # the tile\n\
-               newmtl odd\nmap_d -foo 2 3 -mm 0 1 cut out.png\n\
-               newmtl plain\nmap_Kd plain.png\n\
-               newmtl broken\nmap_Kd -s\nmap_d -mm 1 x.png\n";
+               newmtl odd\nmap_d -foo 2 3 -mm 0 1 cut out.png\nmap_d -bm 2 -mm 0 1 cut out.png\n\
+               newmtl plain\nmap_Kd -dash.png\n\
+               newmtl broken\nmap_Kd -s\nmap_d -mm 1 x.png\nmap_Kd -s 1e39 1 a.png\nmap_Kd -o nan b.png\n";
     let scene = parse_with(&format!("mtllib t.mtl\n{SQUARE}usemtl tiles\nf 1 2 3\n"), &[("t.mtl", mtl)]);
     let [tiles, one, odd, plain, broken] = &scene.materials[..] else { panic!("{:?}", scene.materials) };
     assert_eq!(tiles.map_kd.as_deref(), Some(Path::new("mem/my wood tiles.png")));
@@ -274,15 +297,55 @@ fn texture_options_and_file_names_with_spaces() {
     assert_eq!(one.map_kd_transform, UvTransform { scale: Vec2::new(3.0, 1.0), offset: Vec2::new(-0.5, 0.0) });
     assert_eq!(odd.map_d.as_deref(), Some(Path::new("mem/cut out.png")));
     assert!(odd.map_d_transform.is_identity() && plain.map_kd_transform.is_identity());
-    assert_eq!(plain.map_kd.as_deref(), Some(Path::new("mem/plain.png")));
+    // A last token is the file, even one that looks like an option.
+    assert_eq!(plain.map_kd.as_deref(), Some(Path::new("mem/-dash.png")));
     assert!(broken.map_kd.is_none() && broken.map_d.is_none());
     let expected = [
-        "mem/t.mtl:10: map_Kd -s: expected 1 value(s), found 0; line ignored",
-        "mem/t.mtl:11: map_d -mm: expected 2 value(s), found 1; line ignored",
-        "mem/t.mtl: material \"tiles\" uses statements lumiere does not render: \"map_Kd -blendu -imfchan\" (see docs/MATERIALS.md)",
-        "mem/t.mtl: material \"odd\" uses statements lumiere does not render: \"map_d -foo -mm\" (see docs/MATERIALS.md)",
+        "mem/t.mtl:11: map_Kd \"-s\": expected 1 value(s), found 0; line ignored",
+        "mem/t.mtl:12: map_d \"-mm\": expected 2 value(s), found 1; line ignored",
+        "mem/t.mtl:13: map_Kd \"-s\": number \"1e39\" is not finite; line ignored",
+        "mem/t.mtl:14: map_Kd \"-o\": number \"nan\" is not finite; line ignored",
+        "mem/t.mtl: material \"tiles\" uses statements lumiere does not render: \"map_Kd -imfchan\" (see docs/MATERIALS.md)",
+        "mem/t.mtl: material \"odd\" uses statements lumiere does not render: \"map_d -foo\", \"map_d -mm\", \"map_d -bm\" (see docs/MATERIALS.md)",
     ];
     assert_eq!(scene.warnings, expected);
+}
+
+/// MTL names keep their bytes: a Latin-1 name stays apart from its neighbour (each byte read as
+/// a Latin-1 character), a texture's file name is the bytes on disk, and a byte-order mark
+/// does not hide the first `newmtl`; a binary MTL costs one warning, not one per line.
+#[test]
+fn mtl_names_keep_their_bytes_and_binary_files_one_warning() {
+    let mtl: &[u8] = b"\xEF\xBB\xBFnewmtl caf\xe9\r\nKd 1 0 0\r\nmap_Kd t\xe9x.png\r\nnewmtl caf\xe8\r\nKd 0 0 1\r\n";
+    let mut obj = format!("mtllib m.mtl\n{SQUARE}").into_bytes();
+    obj.extend_from_slice(b"usemtl caf\xe9\nf 1 2 3\nusemtl caf\xe8\nf 1 3 4\n");
+    let read = |name: &str| -> io::Result<(Vec<u8>, PathBuf)> {
+        assert_eq!(name, "m.mtl");
+        Ok((mtl.to_vec(), PathBuf::from("mem/m.mtl")))
+    };
+    let scene = parse_obj(&obj, Path::new("test.obj"), &read).expect("parses");
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    let names: Vec<&str> = scene.materials.iter().map(|m| m.name.as_str()).collect();
+    assert_eq!(names, ["caf\u{e9}", "caf\u{e8}"]);
+    assert_eq!((material_of(&scene, 0).kd, material_of(&scene, 1).kd), (Vec3::X, Vec3::Z));
+    #[cfg(unix)]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        let file = scene.materials[0].map_kd.as_deref().expect("a texture");
+        assert_eq!(file.as_os_str().as_bytes(), b"mem/t\xe9x.png");
+    }
+    let binary = |_: &str| -> io::Result<(Vec<u8>, PathBuf)> {
+        Ok((b"newmtl a\nKd 1 0 0\n\x00\x01\x02\nmore\nlines\n".to_vec(), PathBuf::from("mem/b.mtl")))
+    };
+    let scene =
+        parse_obj(format!("mtllib b.mtl\n{SQUARE}usemtl a\nf 1 2 3\n").as_bytes(), Path::new("test.obj"), &binary)
+            .expect("parses");
+    assert_eq!(scene.warnings.len(), 2, "{:?}", scene.warnings);
+    assert_eq!(
+        scene.warnings[0],
+        "mem/b.mtl:3: a NUL byte: binary data, not an MTL text file; its materials are not read"
+    );
+    assert!(scene.warnings[1].contains("\"a\""), "{:?}", scene.warnings);
 }
 
 #[test]

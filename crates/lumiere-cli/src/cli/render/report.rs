@@ -37,7 +37,12 @@ pub fn progress_bar(total: u64, done: u64) -> ProgressBar {
 /// The closing line: what was rendered, why it stopped, time, rays and speed, where it went.
 pub fn summary(options: &RenderOptions, camera: &Camera, output: &RenderOutput, threads: usize, path: &Path) {
     let noise = output.film.relative_error().map_or(String::new(), |e| format!(", relative error {e:.4}"));
-    let asked = if options.spp == u32::MAX { "unlimited".to_string() } else { options.spp.to_string() };
+    // A resumed checkpoint may hold more than --spp asked for (warned about when it was loaded).
+    let asked = if options.spp == u32::MAX {
+        "unlimited".to_string()
+    } else {
+        options.spp.max(output.film.samples).to_string()
+    };
     let threads = if threads == 1 { "1 thread".to_string() } else { format!("{threads} threads") };
     output::note(format_args!(
         "{} {}x{}: {} after {} of {asked} spp{noise}; {:.1} ms ({threads}), {} rays, {:.1} Mrays/s -> {}",

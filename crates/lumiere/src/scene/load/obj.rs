@@ -19,7 +19,9 @@ use crate::materials::Material;
 use crate::scene::Scene;
 use crate::scene::mesh::{NO_INDEX, TriangleMesh};
 use crate::util::read;
-use chunk::{ChunkCounts, ChunkMesh, ChunkStart, Dropped, Skipped, UNRENDERED, VertexCounts, parse_chunk};
+use chunk::{
+    ChunkCounts, ChunkMesh, ChunkStart, Dropped, SKIPPED_KEYWORDS, Skipped, UNRENDERED, VertexCounts, parse_chunk,
+};
 use materials::{MaterialTable, MtlSource, ReadMtl};
 use rayon::prelude::*;
 use std::io;
@@ -285,7 +287,12 @@ impl<'a> SkippedStatements<'a> {
         }
         if self.others > 0 {
             table.warnings.push(obj, "unknown OBJ statements", || {
-                format!("{}: {} more with other unknown statements ignored", shown_path(obj), lines(self.others))
+                format!(
+                    "{}: {} more with other unknown statements ignored (over {SKIPPED_KEYWORDS} kinds in one part of \
+                     the file, so the counts above may be short)",
+                    shown_path(obj),
+                    lines(self.others)
+                )
             });
         }
     }

@@ -42,6 +42,9 @@ pub(super) struct ChunkCounts {
     /// Triangles the `f` lines make once fanned (a face of n corners makes n - 2), to size the
     /// triangle vectors and estimate the memory before allocating any.
     pub(super) triangles: usize,
+    /// Whether the chunk holds a NUL byte, which text never does: its lines are then checked one
+    /// by one, to name the first.
+    pub(super) binary: bool,
 }
 
 impl ChunkCounts {
@@ -59,6 +62,7 @@ impl ChunkCounts {
         }
         // `lines` yields one more piece than there are `\n` bytes.
         counts.lines -= 1;
+        counts.binary = chunk.contains(&0);
         counts
     }
 }
@@ -133,9 +137,10 @@ pub(super) struct Skipped<'a> {
     pub(super) first_line: usize,
 }
 
-/// How many distinct skipped keywords a chunk keeps; past them a file of junk is only counted, so
-/// that its warnings stay few and its memory bounded.
-const SKIPPED_KEYWORDS: usize = 16;
+/// How many distinct skipped keywords a chunk keeps; past them a file of junk is only counted
+/// (its memory stays bounded). Only a file with more kinds than this in one chunk can see a
+/// keyword's count or first line depend on where the chunks were cut, and its warnings say so.
+pub(super) const SKIPPED_KEYWORDS: usize = 256;
 
 /// Keywords the parser skips without a word: grouping, smoothing and display attributes, and the
 /// parts of free-form geometry that mean nothing without the `curv`/`surf` statements (which are
@@ -212,6 +217,11 @@ pub(super) fn parse_chunk<'a>(
     parser.reserve(counts);
     for (i, line) in lines(chunk).enumerate() {
         let line_number = start.line + i + 1;
+        // Some other format under an `.obj` name (a binary PLY, an archive), whose lines would
+        // otherwise load as nothing or as stray numbers.
+        if counts.binary && line.contains(&0) {
+            return Err(Error::parse(file, line_number, "a NUL byte: binary data, not an OBJ text file".to_string()));
+        }
         parser.statement(line, line_number).map_err(|message| Error::parse(file, line_number, message))?;
     }
     Ok(parser.mesh)
@@ -268,17 +278,9 @@ impl<'a> ChunkParser<'a> {
                 self.mesh.libraries.push(MaterialLibrary { line: line_number, names });
             }
             Some(keyword) if SILENT.contains(&keyword) => {}
-            // Comments and blank lines too (`Tokens` ends a line at `#`).
-            keyword => {
-                // A NUL never occurs in text: this is some other format under an `.obj` name
-                // (a binary PLY, an archive), whose lines would otherwise load as nothing.
-                if line.contains(&0) {
-                    return Err("a NUL byte: binary data, not an OBJ text file".to_string());
-                }
-                if let Some(keyword) = keyword {
-                    self.skip(keyword, line_number);
-                }
-            }
+            Some(keyword) => self.skip(keyword, line_number),
+            // Blank lines and comments (`Tokens` ends a line at `#`).
+            None => {}
         }
         Ok(())
     }

@@ -13,6 +13,19 @@ use std::path::{Path, PathBuf};
 /// line that was ignored (capped, see [`Warnings`]); `map_Kd` and `map_d` files resolve relative to its folder.
 pub(super) fn parse_mtl(bytes: &[u8], path: &Path, warnings: &mut Warnings) -> Vec<Material> {
     let folder = path.parent().unwrap_or(Path::new(""));
+    // Editors on Windows may start the file with a UTF-8 byte-order mark.
+    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    // A NUL never occurs in text: one warning for the file, not one per line of binary data.
+    if let Some(at) = bytes.iter().position(|&b| b == 0) {
+        let line = 1 + bytes[..at].iter().filter(|&&b| b == b'\n').count();
+        warnings.push(path, "binary MTL files", || {
+            format!(
+                "{}:{line}: a NUL byte: binary data, not an MTL text file; its materials are not read",
+                shown_path(path)
+            )
+        });
+        return Vec::new();
+    }
     let mut materials: Vec<Material> = Vec::new();
     // Per material, what it carries that lumiere does not render: unknown statements' keywords
     // (quoted) and texture options.
@@ -31,7 +44,7 @@ pub(super) fn parse_mtl(bytes: &[u8], path: &Path, warnings: &mut Warnings) -> V
             }
             Ok(Some(statement)) => match materials.last_mut() {
                 Some(material) => {
-                    if let Some(option) = statement.texture_option() {
+                    for option in statement.texture_options() {
                         note(&mut unsupported, option);
                     }
                     statement.apply(material);
@@ -106,15 +119,15 @@ enum Statement {
 }
 
 impl Statement {
-    /// The options of a texture statement that lumiere does not honour (`map_Kd -bm 1 …`), as
-    /// `"map_Kd -bm"`: they cost a warning, since they change what a surface looks like.
-    fn texture_option(&self) -> Option<String> {
+    /// The options of a texture statement that lumiere does not honour (`map_Kd -bm 1 …`), each
+    /// as `"map_Kd -bm"`: they cost a warning, since they change what a surface looks like.
+    fn texture_options(&self) -> Vec<String> {
         let (keyword, options) = match self {
             Statement::DiffuseMap(map) => ("map_Kd", &map.options),
             Statement::CoverageMap(map) => ("map_d", &map.options),
-            _ => return None,
+            _ => return Vec::new(),
         };
-        (!options.is_empty()).then(|| quote(format!("{keyword} {}", options.join(" "))))
+        options.iter().map(|option| quote(format!("{keyword} {option}"))).collect()
     }
 
     fn apply(self, material: &mut Material) {
@@ -238,6 +251,28 @@ fn option_values(option: &[u8]) -> Option<(usize, usize)> {
     }
 }
 
+/// Whether `token` starts an option: a `-` and not a number (`-0.5` is a value).
+fn is_option(token: &[u8]) -> bool {
+    token.starts_with(b"-") && token.len() > 1 && finite_f32(token).is_err()
+}
+
+/// Whether `token` is a number for Rust's parser, finite or not.
+fn parses_as_f32(token: &[u8]) -> bool {
+    std::str::from_utf8(token).is_ok_and(|text| text.parse::<f32>().is_ok())
+}
+
+/// Options whose value is what lumiere does anyway: repeat wrapping (`-clamp off`), blending and
+/// no colour correction (`-blendu on`, `-blendv on`, `-cc off`). They cost no warning.
+fn asks_for_the_default(option: &[u8], values: &[&[u8]]) -> bool {
+    let [value] = values else { return false };
+    let default: &[u8] = match option {
+        b"-clamp" | b"-cc" => b"off",
+        b"-blendu" | b"-blendv" => b"on",
+        _ => return false,
+    };
+    value.eq_ignore_ascii_case(default)
+}
+
 /// Parses `[options] file`: options come first, each a token that starts with `-` and is not a
 /// number, with its values; the rest of the line, spaces included, is the file (Blender writes
 /// names with spaces unquoted). `-s` and `-o` place the texture (their u and v; w is for 3D
@@ -248,7 +283,11 @@ fn texture_map(keyword: &str, mut tokens: Tokens, folder: &Path) -> Result<Textu
     let mut options = Vec::new();
     loop {
         let mut ahead = tokens.clone();
-        let Some(option) = ahead.next().filter(|t| t.starts_with(b"-") && finite_f32(t).is_err()) else { break };
+        let Some(option) = ahead.next().filter(|t| is_option(t)) else { break };
+        // The last token is the file, even one whose name starts with `-`.
+        if option_values(option).is_none() && ahead.clone().next().is_none() {
+            break;
+        }
         tokens = ahead;
         let shown = String::from_utf8_lossy(option).into_owned();
         let values: Vec<&[u8]> = match option_values(option) {
@@ -264,7 +303,15 @@ fn texture_map(keyword: &str, mut tokens: Tokens, folder: &Path) -> Result<Textu
                     tokens = ahead;
                 }
                 if values.len() < least {
-                    return Err(format!("{keyword} {shown}: expected {least} value(s), found {}", values.len()));
+                    // Name a value that is there but not finite (`-s 1e39`, `-o nan`); another
+                    // word is the file, after too few values.
+                    let problem = match tokens.clone().next() {
+                        Some(token) if numeric && parses_as_f32(token) => finite_f32(token).err(),
+                        _ => None,
+                    };
+                    let problem =
+                        problem.unwrap_or_else(|| format!("expected {least} value(s), found {}", values.len()));
+                    return Err(format!("{keyword} {}: {problem}", quoted(option)));
                 }
                 values
             }
@@ -280,13 +327,28 @@ fn texture_map(keyword: &str, mut tokens: Tokens, folder: &Path) -> Result<Textu
         match option {
             b"-s" => transform.scale = glam::Vec2::new(number(0, 1.0)?, number(1, 1.0)?),
             b"-o" => transform.offset = glam::Vec2::new(number(0, 0.0)?, number(1, 0.0)?),
-            b"-clamp" if values == [b"off"] => {}
+            _ if asks_for_the_default(option, &values) => {}
             _ => options.push(shown),
         }
     }
-    let file = tokens.remainder();
+    let file = tokens.remainder_bytes();
     if file.is_empty() {
         return Err(format!("{keyword} without a file name"));
     }
-    Ok(TextureMap { path: folder.join(file.replace('\\', "/")), transform, options })
+    let file: Vec<u8> = file.iter().map(|&b| if b == b'\\' { b'/' } else { b }).collect();
+    Ok(TextureMap { path: folder.join(path_from_bytes(file)), transform, options })
+}
+
+/// A file name from the MTL's bytes: as they are on Unix, where names are bytes; elsewhere as
+/// text (see [`super::text::text`]).
+fn path_from_bytes(bytes: Vec<u8>) -> PathBuf {
+    #[cfg(unix)]
+    {
+        use std::os::unix::ffi::OsStringExt;
+        PathBuf::from(std::ffi::OsString::from_vec(bytes))
+    }
+    #[cfg(not(unix))]
+    {
+        PathBuf::from(super::text::text(&bytes).into_owned())
+    }
 }

@@ -26,15 +26,32 @@ impl<'a> Tokens<'a> {
         Tokens { rest: line }
     }
 
-    /// What is left of the line, trimmed, as one name: material and file names may contain spaces.
-    pub(super) fn remainder(self) -> Cow<'a, str> {
+    /// What is left of the line, trimmed and without a trailing comment, as its bytes: file names
+    /// keep them, so that a name in the file's own encoding finds its file.
+    pub(super) fn remainder_bytes(self) -> &'a [u8] {
         let rest = self.rest.trim_ascii_start();
         let comment = rest
             .iter()
             .enumerate()
             .position(|(i, &b)| b == b'#' && (i == 0 || rest[i - 1].is_ascii_whitespace()))
             .unwrap_or(rest.len());
-        String::from_utf8_lossy(rest[..comment].trim_ascii_end())
+        rest[..comment].trim_ascii_end()
+    }
+
+    /// What is left of the line, trimmed, as one name (see [`text`]): material and file names may
+    /// contain spaces.
+    pub(super) fn remainder(self) -> Cow<'a, str> {
+        text(self.remainder_bytes())
+    }
+}
+
+/// A name as text: UTF-8 where it is valid, otherwise each byte read as Latin-1, as older
+/// exporters wrote names, so that two names whose bytes differ stay two names (a lossy decoding
+/// would make `caf\xe9` and `caf\xe8` one material).
+pub(super) fn text(bytes: &[u8]) -> Cow<'_, str> {
+    match std::str::from_utf8(bytes) {
+        Ok(text) => Cow::Borrowed(text),
+        Err(_) => Cow::Owned(bytes.iter().map(|&b| char::from(b)).collect()),
     }
 }
 
