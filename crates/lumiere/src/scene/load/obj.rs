@@ -12,18 +12,18 @@
 mod chunk;
 mod materials;
 mod mtl;
+mod skipped;
 mod text;
 
-use crate::error::{Error, Result, quote, shown_path};
+use crate::error::{Error, Result, shown_path};
 use crate::materials::Material;
 use crate::scene::Scene;
 use crate::scene::mesh::{NO_INDEX, TriangleMesh};
 use crate::util::read;
-use chunk::{
-    ChunkCounts, ChunkMesh, ChunkStart, Dropped, SKIPPED_KEYWORDS, Skipped, UNRENDERED, VertexCounts, parse_chunk,
-};
+use chunk::{ChunkCounts, ChunkMesh, ChunkStart, Dropped, VertexCounts, parse_chunk};
 use materials::{MaterialTable, MtlSource, ReadMtl};
 use rayon::prelude::*;
+use skipped::SkippedStatements;
 use std::io;
 use std::path::{Path, PathBuf};
 
@@ -166,8 +166,8 @@ fn parse_obj_within(
         .collect();
     // Sequentially, so that the error reported is the first one in the file.
     let parsed = parsed.into_iter().collect::<Result<Vec<_>>>()?;
-    let skipped = SkippedStatements::of(&parsed);
-    skipped.refuse_if_not_obj(&parsed, name)?;
+    let skipped = SkippedStatements::of(parsed.iter().map(|chunk| &chunk.skipped));
+    skipped.refuse_if_not_obj(parsed.iter().any(|chunk| !chunk.indices.is_empty()), name)?;
     let libraries = parsed.iter().flat_map(|chunk| &chunk.libraries);
     let mut table = MaterialTable::load(libraries, name, source);
     let material_ids = material_ids(&parsed, &mut table, name);
@@ -176,7 +176,7 @@ fn parse_obj_within(
     let kind = "texture-coordinate indices out of range";
     warn_dropped(&mut table, name, texcoords, "texture-coordinate", "texture coordinates", kind);
     warn_dropped(&mut table, name, normals, "normal", "normals", "normal indices out of range");
-    skipped.warn(&mut table, name);
+    skipped.warn(&mut table.warnings, name);
     let warnings = std::mem::take(&mut table.warnings).finish();
     Ok(ObjScene {
         mesh: merge(&parsed, material_ids),
@@ -226,76 +226,6 @@ fn warn_dropped(table: &mut MaterialTable, obj: &Path, dropped: Dropped, what: &
             shown_path(obj)
         )
     });
-}
-
-/// The statements of the whole file that the chunks skipped, by keyword in order of first use.
-struct SkippedStatements<'a> {
-    by_keyword: Vec<Skipped<'a>>,
-    /// Lines of keywords past each chunk's list (see `chunk::SKIPPED_KEYWORDS`).
-    others: usize,
-}
-
-impl<'a> SkippedStatements<'a> {
-    fn of(chunks: &[ChunkMesh<'a>]) -> Self {
-        let mut by_keyword: Vec<Skipped> = Vec::new();
-        for skipped in chunks.iter().flat_map(|chunk| &chunk.skipped) {
-            match by_keyword.iter_mut().find(|s| s.keyword == skipped.keyword) {
-                Some(known) => known.lines += skipped.lines,
-                None => by_keyword.push(*skipped),
-            }
-        }
-        SkippedStatements { by_keyword, others: chunks.iter().map(|chunk| chunk.skipped_others).sum() }
-    }
-
-    fn unknown(&self) -> impl Iterator<Item = &Skipped<'a>> {
-        self.by_keyword.iter().filter(|s| !UNRENDERED.iter().any(|(keyword, _)| *keyword == s.keyword))
-    }
-
-    /// A file without a single face whose other lines are not OBJ either is not an OBJ file: say
-    /// so, rather than render nothing.
-    fn refuse_if_not_obj(&self, chunks: &[ChunkMesh], obj: &Path) -> Result<()> {
-        let Some(first) = self.unknown().next() else { return Ok(()) };
-        if chunks.iter().any(|chunk| !chunk.indices.is_empty()) {
-            return Ok(());
-        }
-        let message =
-            format!("unknown statement {} and not one face in the file: is it an OBJ file?", quote(first.keyword));
-        Err(Error::parse(obj, first.first_line, message))
-    }
-
-    /// One warning per keyword: what lumiere does not render, and what it does not know.
-    fn warn(&self, table: &mut MaterialTable, obj: &Path) {
-        let lines = |n: usize| if n == 1 { "1 line".to_string() } else { format!("{n} lines") };
-        for skipped in &self.by_keyword {
-            let (keyword, count, line) = (quote(skipped.keyword), skipped.lines, skipped.first_line);
-            match UNRENDERED.iter().find(|(k, _)| *k == skipped.keyword) {
-                Some((_, what)) => table.warnings.push(obj, "unrendered OBJ elements", || {
-                    format!(
-                        "{}:{line}: {keyword} statements ({what}) are not rendered: {} ignored, the first on this line",
-                        shown_path(obj),
-                        lines(count)
-                    )
-                }),
-                None => table.warnings.push(obj, "unknown OBJ statements", || {
-                    format!(
-                        "{}:{line}: unknown statement {keyword}: {} ignored, the first on this line",
-                        shown_path(obj),
-                        lines(count)
-                    )
-                }),
-            }
-        }
-        if self.others > 0 {
-            table.warnings.push(obj, "unknown OBJ statements", || {
-                format!(
-                    "{}: {} more with other unknown statements ignored (over {SKIPPED_KEYWORDS} kinds in one part of \
-                     the file, so the counts above may be short)",
-                    shown_path(obj),
-                    lines(self.others)
-                )
-            });
-        }
-    }
 }
 
 /// Cuts `bytes` into pieces of about `target` bytes, each ending just after a `\n` (but the last).

@@ -5,6 +5,7 @@
 //! whole file has. [`parse_chunk`] then turns relative (negative) indices into absolute ones at
 //! once and reports errors with their line number in the file, with no fix-up pass afterwards.
 
+use super::skipped::{SkippedKeywords, is_silent};
 use super::text::{Tokens, finite_f32, lines, quoted, saturating_i64};
 use crate::error::{Error, Result};
 use crate::scene::mesh::NO_INDEX;
@@ -122,67 +123,9 @@ pub(super) struct ChunkMesh<'a> {
     pub(super) dropped_texcoords: Dropped,
     /// Faces with a normal index out of range (dropped for those corners).
     pub(super) dropped_normals: Dropped,
-    /// Statements skipped that a reader should hear about, by keyword, in order of first use.
-    pub(super) skipped: Vec<Skipped<'a>>,
-    /// Skipped lines whose keyword came after the chunk had kept [`SKIPPED_KEYWORDS`] others.
-    pub(super) skipped_others: usize,
+    /// Statements skipped that a reader should hear about.
+    pub(super) skipped: SkippedKeywords<'a>,
 }
-
-/// The statements of one keyword that the parser skipped although they may carry content: elements
-/// lumiere does not render (`l`, `p`, free-form geometry) or a keyword that is not OBJ at all.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Skipped<'a> {
-    pub(super) keyword: &'a [u8],
-    pub(super) lines: usize,
-    pub(super) first_line: usize,
-}
-
-/// How many distinct skipped keywords a chunk keeps; past them a file of junk is only counted
-/// (its memory stays bounded). Only a file with more kinds than this in one chunk can see a
-/// keyword's count or first line depend on where the chunks were cut, and its warnings say so.
-pub(super) const SKIPPED_KEYWORDS: usize = 256;
-
-/// Keywords the parser skips without a word: grouping, smoothing and display attributes, and the
-/// parts of free-form geometry that mean nothing without the `curv`/`surf` statements (which are
-/// warned about).
-const SILENT: [&[u8]; 26] = [
-    b"o",
-    b"g",
-    b"s",
-    b"mg",
-    b"vp",
-    b"cstype",
-    b"deg",
-    b"bmat",
-    b"step",
-    b"parm",
-    b"trim",
-    b"hole",
-    b"scrv",
-    b"sp",
-    b"end",
-    b"con",
-    b"bevel",
-    b"c_interp",
-    b"d_interp",
-    b"lod",
-    b"usemap",
-    b"maplib",
-    b"shadow_obj",
-    b"trace_obj",
-    b"ctech",
-    b"stech",
-];
-
-/// Elements of the OBJ format that lumiere does not render, with what they are.
-pub(super) const UNRENDERED: [(&[u8], &str); 6] = [
-    (b"l", "polylines"),
-    (b"p", "points"),
-    (b"curv", "free-form curves"),
-    (b"curv2", "free-form curves"),
-    (b"surf", "free-form surfaces"),
-    (b"call", "calls to other files"),
-];
 
 /// Faces that lost an attribute index because it pointed at nothing.
 #[derive(Clone, Copy, Debug, Default)]
@@ -277,23 +220,12 @@ impl<'a> ChunkParser<'a> {
                 let names = tokens.remainder();
                 self.mesh.libraries.push(MaterialLibrary { line: line_number, names });
             }
-            Some(keyword) if SILENT.contains(&keyword) => {}
-            Some(keyword) => self.skip(keyword, line_number),
+            Some(keyword) if is_silent(keyword) => {}
+            Some(keyword) => self.mesh.skipped.note(keyword, line_number),
             // Blank lines and comments (`Tokens` ends a line at `#`).
             None => {}
         }
         Ok(())
-    }
-
-    fn skip(&mut self, keyword: &'a [u8], line: usize) {
-        let skipped = &mut self.mesh.skipped;
-        if let Some(known) = skipped.iter_mut().find(|s| s.keyword == keyword) {
-            known.lines += 1;
-        } else if skipped.len() < SKIPPED_KEYWORDS {
-            skipped.push(Skipped { keyword, lines: 1, first_line: line });
-        } else {
-            self.mesh.skipped_others += 1;
-        }
     }
 
     fn use_material(&mut self, tokens: Tokens<'a>, line: usize) -> Result<(), String> {
