@@ -476,3 +476,21 @@ fn a_read_only_output_is_refused_and_kept() {
     assert!(out.status.success(), "{}", stderr(&out));
     assert_ne!(fs::read(&target).unwrap(), b"precious");
 }
+
+/// `lumiere info` names a texture that is missing or not a file, as a render would, so that a
+/// surface that comes out plain is explained before any render.
+#[test]
+fn info_names_missing_textures() {
+    let dir = TempDir::new("info-textures");
+    dir.write("m.mtl", "newmtl a\nmap_Kd -s 2 2 missing wood.png\nnewmtl b\nmap_d folder.png\nmap_Kd here.png\n");
+    fs::create_dir(dir.path("folder.png")).unwrap();
+    dir.write("here.png", b"any bytes: info does not decode");
+    let obj = dir.write("s.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\nusemtl b\nf 1 2 3\n");
+    let out = run(&["info", obj.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let warnings: Vec<String> =
+        stderr(&out).lines().filter(|l| l.contains("warning: texture")).map(String::from).collect();
+    assert_eq!(warnings.len(), 2, "{warnings:?}");
+    assert!(warnings[0].contains("missing wood.png") && warnings[0].contains("Kd is used instead"), "{warnings:?}");
+    assert!(warnings[1].contains("folder.png\": not a regular file; the material stays opaque"), "{warnings:?}");
+}
