@@ -9,6 +9,7 @@ use std::time::Instant;
 use glam::{Vec2, Vec3};
 use lumiere::accel::BuildPreset;
 use lumiere::materials::Material;
+use lumiere::math::UvTransform;
 use lumiere::render::fingerprint::scene_fingerprint;
 use lumiere::scene::Scene;
 use lumiere::scene::mesh::TriangleMesh;
@@ -170,7 +171,9 @@ impl PyScene {
             entry.set_item("kd", material.kd.to_array())?;
             entry.set_item("ke", material.ke.to_array())?;
             entry.set_item("texture", material.map_kd.as_ref().map(|p| p.display().to_string()))?;
+            entry.set_item("texture_placement", placement(py, material.map_kd_transform)?)?;
             entry.set_item("cutout", material.map_d.as_ref().map(|p| p.display().to_string()))?;
+            entry.set_item("cutout_placement", placement(py, material.map_d_transform)?)?;
             entry.set_item("light", material.is_emissive())?;
             materials.set_item(&material.name, entry)?;
         }
@@ -185,4 +188,16 @@ impl PyScene {
         let scene = self.world.scene();
         format!("<lumiere scene {:?}: {} triangles>", scene.name, scene.mesh.triangle_count())
     }
+}
+
+/// A texture's `-s` and `-o` as `{'scale': (u, v), 'offset': (u, v)}`, or `None` where they leave
+/// it in place.
+fn placement(py: Python<'_>, transform: UvTransform) -> PyResult<Option<Bound<'_, PyDict>>> {
+    if transform.is_identity() {
+        return Ok(None);
+    }
+    let entry = PyDict::new(py);
+    entry.set_item("scale", transform.scale.to_array())?;
+    entry.set_item("offset", transform.offset.to_array())?;
+    Ok(Some(entry))
 }
