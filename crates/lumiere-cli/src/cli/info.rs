@@ -11,6 +11,7 @@ use lumiere::lights::LightSet;
 use lumiere::materials::{Material, MaterialKind};
 use lumiere::math::UvTransform;
 use lumiere::scene::Scene;
+use lumiere::textures::TextureSet;
 
 use super::args::InfoArgs;
 use super::output;
@@ -25,7 +26,13 @@ pub fn run(args: &InfoArgs) -> Result<()> {
     for warning in &scene.warnings {
         output::warn(warning);
     }
-    warn_about_missing_textures(&scene);
+    // Named as a render would name them, from their metadata: a render decodes them when it
+    // builds the world, and a user asking why a surface comes out plain learns it here.
+    let materials = &scene.materials;
+    let (map_kd, map_d) = (materials.iter().map(|m| m.map_kd.as_deref()), materials.iter().map(|m| m.map_d.as_deref()));
+    for warning in TextureSet::unreadable_files(map_kd, map_d) {
+        output::warn(warning);
+    }
     let lights = LightSet::new(&scene);
     let lights = lights.lights();
     let light_area: f32 = lights.iter().map(|l| l.area).fold(0.0, |a, b| a + b);
@@ -55,27 +62,6 @@ pub fn run(args: &InfoArgs) -> Result<()> {
         output::print(format_args!("  {:?}: {triangles} triangles, {}", material.name, describe(material)))?;
     }
     Ok(())
-}
-
-/// A texture that is not there, or not a regular file, is named here, as a render would name
-/// it, without decoding any (a render decodes them when it builds the world): a user asking why
-/// a surface comes out plain learns it from `info`.
-fn warn_about_missing_textures(scene: &Scene) {
-    let mut named = Vec::new();
-    for material in &scene.materials {
-        let maps =
-            [(&material.map_kd, "the material's Kd is used instead"), (&material.map_d, "the material stays opaque")];
-        for (path, instead) in maps {
-            let Some(path) = path.as_deref().filter(|path| !named.contains(path)) else { continue };
-            named.push(path);
-            let problem = match std::fs::metadata(path) {
-                Ok(metadata) if metadata.is_file() => continue,
-                Ok(_) => "not a regular file".to_string(),
-                Err(error) => error.to_string(),
-            };
-            output::warn(format_args!("texture {:?}: {problem}; {instead}", path.to_string_lossy()));
-        }
-    }
 }
 
 fn line(key: &str, value: impl Display) -> Result<()> {

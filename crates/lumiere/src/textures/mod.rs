@@ -381,7 +381,7 @@ impl TextureSet {
     /// that decoded, with one warning for each path that did not, in the order of `paths`:
     /// `texture "PATH": REASON; the material's Kd is used instead`.
     pub fn load<P: AsRef<Path> + Sync>(paths: &[P]) -> (TextureSet, Vec<String>) {
-        TextureSet::load_or(paths, "the material's Kd is used instead")
+        TextureSet::load_or(paths, WITHOUT_DIFFUSE)
     }
 
     /// [`TextureSet::load`], whose warnings end with `instead` (what the material does without
@@ -402,9 +402,7 @@ impl TextureSet {
                     set.textures.push(texture);
                     set.paths.push(path.to_path_buf());
                 }
-                // Quoted and escaped like a string literal (not cut: the user must find the file),
-                // so that a control character from the MTL file cannot garble the line.
-                Err(reason) => warnings.push(format!("texture {:?}: {reason}; {instead}", path.to_string_lossy())),
+                Err(reason) => warnings.push(unusable(path, &reason, instead)),
             }
         }
         (set, warnings)
@@ -416,7 +414,7 @@ impl TextureSet {
     pub fn for_materials<'a>(
         map_kd: impl IntoIterator<Item = Option<&'a Path>>,
     ) -> (Vec<Option<TextureId>>, TextureSet, Vec<String>) {
-        TextureSet::per_material(map_kd, "the material's Kd is used instead")
+        TextureSet::per_material(map_kd, WITHOUT_DIFFUSE)
     }
 
     /// As [`TextureSet::for_materials`], for each material's coverage texture (`map_d`, for
@@ -424,7 +422,33 @@ impl TextureSet {
     pub fn for_cutouts<'a>(
         map_d: impl IntoIterator<Item = Option<&'a Path>>,
     ) -> (Vec<Option<TextureId>>, TextureSet, Vec<String>) {
-        TextureSet::per_material(map_d, "the material stays opaque")
+        TextureSet::per_material(map_d, WITHOUT_COVERAGE)
+    }
+
+    /// The warnings [`TextureSet::for_materials`] and [`TextureSet::for_cutouts`] would give
+    /// for the files among `map_kd` and `map_d` that are missing, not regular files or too
+    /// large: the checks that need no decoding, so they cost no more than a file's metadata
+    /// (what `lumiere info` shows).
+    pub fn unreadable_files<'a>(
+        map_kd: impl IntoIterator<Item = Option<&'a Path>>,
+        map_d: impl IntoIterator<Item = Option<&'a Path>>,
+    ) -> Vec<String> {
+        let mut warnings = Vec::new();
+        for (paths, instead) in
+            [(map_kd.into_iter().collect::<Vec<_>>(), WITHOUT_DIFFUSE), (map_d.into_iter().collect(), WITHOUT_COVERAGE)]
+        {
+            let mut seen: Vec<&Path> = Vec::new();
+            for path in paths.into_iter().flatten() {
+                if seen.contains(&path) {
+                    continue;
+                }
+                seen.push(path);
+                if let Err(reason) = check_file(path) {
+                    warnings.push(unusable(path, &reason, instead));
+                }
+            }
+        }
+        warnings
     }
 
     /// One optional texture path per material → each material's texture id, the set, and the
@@ -482,8 +506,20 @@ impl TextureSet {
     }
 }
 
-/// Reads and decodes one texture file; the error is a reason without the file name.
-fn read_texture(path: &Path) -> Result<Texture, String> {
+/// What a material does without its diffuse texture, or without its coverage texture: the end
+/// of each warning about a file that cannot be used.
+const WITHOUT_DIFFUSE: &str = "the material's Kd is used instead";
+const WITHOUT_COVERAGE: &str = "the material stays opaque";
+
+/// The warning about texture file `path`: quoted and escaped like a string literal (not cut: the
+/// user must find the file), so that a control character from the MTL file cannot garble the line.
+fn unusable(path: &Path, reason: &str, instead: &str) -> String {
+    format!("texture {:?}: {reason}; {instead}", path.to_string_lossy())
+}
+
+/// The checks on a texture file that its metadata answers: it is there, a regular file, and not
+/// larger than [`MAX_FILE_BYTES`].
+fn check_file(path: &Path) -> Result<(), String> {
     let metadata = std::fs::metadata(path).map_err(|e| e.to_string())?;
     if !metadata.is_file() {
         return Err("not a regular file".to_string());
@@ -491,6 +527,12 @@ fn read_texture(path: &Path) -> Result<Texture, String> {
     if metadata.len() > MAX_FILE_BYTES {
         return Err(format!("the file has {} bytes, over the limit of {MAX_FILE_BYTES}", metadata.len()));
     }
+    Ok(())
+}
+
+/// Reads and decodes one texture file; the error is a reason without the file name.
+fn read_texture(path: &Path) -> Result<Texture, String> {
+    check_file(path)?;
     let bytes = crate::util::read::read_regular_file(path).map_err(|e| e.to_string())?;
     Texture::decode_named(&bytes, Some(path))
 }

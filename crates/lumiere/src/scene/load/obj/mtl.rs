@@ -284,51 +284,20 @@ fn texture_map(keyword: &str, mut tokens: Tokens, folder: &Path) -> Result<Textu
     loop {
         let mut ahead = tokens.clone();
         let Some(option) = ahead.next().filter(|t| is_option(t)) else { break };
+        let arity = option_values(option);
         // The last token is the file, even one whose name starts with `-`.
-        if option_values(option).is_none() && ahead.clone().next().is_none() {
+        if arity.is_none() && ahead.clone().next().is_none() {
             break;
         }
         tokens = ahead;
-        let shown = String::from_utf8_lossy(option).into_owned();
-        let values: Vec<&[u8]> = match option_values(option) {
-            Some((least, most)) => {
-                let numeric = !matches!(option, b"-blendu" | b"-blendv" | b"-cc" | b"-clamp" | b"-imfchan" | b"-type");
-                let mut values = Vec::new();
-                while values.len() < most {
-                    let mut ahead = tokens.clone();
-                    match ahead.next() {
-                        Some(value) if !numeric || finite_f32(value).is_ok() => values.push(value),
-                        _ => break,
-                    }
-                    tokens = ahead;
-                }
-                if values.len() < least {
-                    // Name a value that is there but not finite (`-s 1e39`, `-o nan`); another
-                    // word is the file, after too few values.
-                    let problem = match tokens.clone().next() {
-                        Some(token) if numeric && parses_as_f32(token) => finite_f32(token).err(),
-                        _ => None,
-                    };
-                    let problem =
-                        problem.unwrap_or_else(|| format!("expected {least} value(s), found {}", values.len()));
-                    return Err(format!("{keyword} {}: {problem}", quoted(option)));
-                }
-                values
-            }
-            // An option unknown to the specification: its numbers go with it.
-            None => {
-                while tokens.clone().next().is_some_and(|t| finite_f32(t).is_ok()) {
-                    tokens.next();
-                }
-                Vec::new()
-            }
-        };
-        let number = |k: usize, default: f32| values.get(k).map_or(Ok(default), |v| finite_f32(v));
+        let values = take_values(keyword, option, arity, &mut tokens)?;
+        // The values of `-s` and `-o` are finite numbers (`take_values`).
+        let number = |k: usize, default: f32| values.get(k).and_then(|v| finite_f32(v).ok()).unwrap_or(default);
         match option {
-            b"-s" => transform.scale = glam::Vec2::new(number(0, 1.0)?, number(1, 1.0)?),
-            b"-o" => transform.offset = glam::Vec2::new(number(0, 0.0)?, number(1, 0.0)?),
+            b"-s" => transform.scale = glam::Vec2::new(number(0, 1.0), number(1, 1.0)),
+            b"-o" => transform.offset = glam::Vec2::new(number(0, 0.0), number(1, 0.0)),
             _ if asks_for_the_default(option, &values) => {}
-            _ => options.push(shown),
+            _ => options.push(String::from_utf8_lossy(option).into_owned()),
         }
     }
     let file = tokens.remainder_bytes();
@@ -337,6 +306,43 @@ fn texture_map(keyword: &str, mut tokens: Tokens, folder: &Path) -> Result<Textu
     }
     let file: Vec<u8> = file.iter().map(|&b| if b == b'\\' { b'/' } else { b }).collect();
     Ok(TextureMap { path: folder.join(path_from_bytes(file)), transform, options })
+}
+
+/// Takes the values of texture option `option` (with `arity`, from [`option_values`]) off
+/// `tokens`: as many as it takes, numbers where they must be; an option unknown to the
+/// specification takes the numbers that follow it.
+fn take_values<'a>(
+    keyword: &str,
+    option: &[u8],
+    arity: Option<(usize, usize)>,
+    tokens: &mut Tokens<'a>,
+) -> Result<Vec<&'a [u8]>, String> {
+    let numeric = !matches!(option, b"-blendu" | b"-blendv" | b"-cc" | b"-clamp" | b"-imfchan" | b"-type");
+    let (least, most) = arity.unwrap_or((0, usize::MAX));
+    let mut values = Vec::new();
+    while values.len() < most {
+        let mut ahead = tokens.clone();
+        match ahead.next() {
+            Some(value) if !numeric || finite_f32(value).is_ok() => values.push(value),
+            _ => break,
+        }
+        *tokens = ahead;
+    }
+    if arity.is_none() {
+        // Its values are not options lumiere reads: only skipped.
+        return Ok(Vec::new());
+    }
+    if values.len() < least {
+        // Name a value that is there but not finite (`-s 1e39`, `-o nan`); another word is the
+        // file, after too few values.
+        let problem = match tokens.clone().next() {
+            Some(token) if numeric && parses_as_f32(token) => finite_f32(token).err(),
+            _ => None,
+        };
+        let problem = problem.unwrap_or_else(|| format!("expected {least} value(s), found {}", values.len()));
+        return Err(format!("{keyword} {}: {problem}", quoted(option)));
+    }
+    Ok(values)
 }
 
 /// A file name from the MTL's bytes: as they are on Unix, where names are bytes; elsewhere as
