@@ -97,9 +97,14 @@ const QUARTERS: usize = 4;
 /// A shaft towards a quad: four sides, the quad's plane and the surface the rays leave.
 const MAX_PLANES: usize = 6;
 
+// The constructors and their helpers are `#[inline]`: the integrators call them once per receiver
+// and light (soft shadows) or receiver (ambient occlusion) from another codegen unit, where, out of
+// line, each returned its `Region` through memory and the planes' square roots and divisions
+// waited on calls. Soft shadows N = 16 took 10% longer (BENCHMARKS.md, sixth session of 2026-12-05).
 impl Region {
     /// The tetrahedron spanned by `origin` and the triangle `corners` (the shaft of all segments
     /// from the origin to points of the triangle).
+    #[inline]
     pub fn shaft(origin: Vec3, corners: [Vec3; 3]) -> Option<Region> {
         let centroid = (origin + corners[0] + corners[1] + corners[2]) * 0.25;
         let faces = [
@@ -121,6 +126,7 @@ impl Region {
     /// The pyramid spanned by `origin` and the convex quad `corners` (in order around it), cut by
     /// `plane` (`n . x + w`, positive at the origin), on or behind which every segment from the
     /// origin into the quad ends; `None` if the origin is not in front of it.
+    #[inline]
     pub fn shaft_to_quad(origin: Vec3, corners: [Vec3; 4], plane: Vec4) -> Option<Region> {
         // In front of the plane (a NaN distance is not).
         if plane.truncate().dot(origin) + plane.w <= 0.0 || plane.is_nan() || origin.is_nan() {
@@ -137,6 +143,7 @@ impl Region {
 
     /// The half-space above the plane through `origin` with normal `normal`: rays leaving `origin`
     /// on that side never reach anything on or below the plane.
+    #[inline]
     pub fn hemisphere(origin: Vec3, normal: Vec3) -> Region {
         let n = normal.normalize();
         let mut planes = [Vec4::ZERO; MAX_PLANES];
@@ -152,6 +159,7 @@ impl Region {
     /// strays out of its quarter by rounding (its sine or cosine a few ulps below zero at a side)
     /// still finds every triangle that can block it within that distance, as a quarter keeps what
     /// lies a few thousand ulps of `reach` beyond its sides.
+    #[inline]
     pub fn hemisphere_in_quarters(origin: Vec3, frame: &Frame, reach: f32) -> Region {
         let through_origin = |n: Vec3| n.extend(-n.dot(origin));
         let quarters = Quarters {
@@ -166,6 +174,7 @@ impl Region {
     /// leave, all of them above it): what lies wholly on or below it is left out, which in a
     /// shaft is mostly the receiver's own triangles, kept by its sides' margins where they meet at
     /// the origin (a shaft to the Cornell box's light held them alone seven times in ten).
+    #[inline]
     pub fn above(mut self, origin: Vec3, normal: Vec3) -> Region {
         debug_assert!(self.count < MAX_PLANES, "a region has at most {MAX_PLANES} planes");
         let n = normal.normalize();
@@ -226,6 +235,7 @@ impl Region {
 }
 
 /// The plane through `a`, `b`, `c`, its unit normal turned towards `inside`; `None` if degenerate.
+#[inline]
 fn plane_facing(a: Vec3, b: Vec3, c: Vec3, inside: Vec3) -> Option<Vec4> {
     let n = (b - a).cross(c - a).try_normalize()?;
     let n = if n.dot(inside - a) < 0.0 { -n } else { n };
@@ -256,11 +266,13 @@ fn distance_range<const W: usize, L: Lanes<W>>(plane: &Vec4, vertices: &[[[f32; 
 
 /// A few thousand ulps of the coordinates of a shaft from `origin` to `corners`: far above
 /// rounding, far below any geometry.
+#[inline]
 fn tolerance(origin: Vec3, corners: &[Vec3]) -> f32 {
     tolerance_within(origin, corners.iter().map(|c| (*c - origin).length()).fold(0.0f32, f32::max))
 }
 
 /// A few thousand ulps of the coordinates of a region reaching `size` from `origin`.
+#[inline]
 fn tolerance_within(origin: Vec3, size: f32) -> f32 {
     4096.0 * f32::EPSILON * (origin.abs().max_element() + size)
 }
