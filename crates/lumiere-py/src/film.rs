@@ -71,7 +71,8 @@ impl PyFilm {
         let values = from_bytes(values, self.film.pixel_count(), &format!("pass {sample}"))?;
         let pass = PassSamples { sample, width: self.film.width, height: self.film.height, values, rays };
         self.film.add_pass(&pass).or_py()?;
-        self.stats.rays += rays;
+        // A count this large is nonsense, but it must not wrap around to a small one.
+        self.stats.rays = self.stats.rays.saturating_add(rays);
         Ok(())
     }
 
@@ -99,7 +100,8 @@ impl PyFilm {
 
     #[setter]
     fn set_seconds(&mut self, seconds: f64) -> PyResult<()> {
-        self.stats.elapsed = Duration::try_from_secs_f64(seconds).map_err(|_| invalid("seconds must be >= 0"))?;
+        self.stats.elapsed = Duration::try_from_secs_f64(seconds)
+            .map_err(|_| invalid(format!("seconds must be at least 0 and below 2^64, got {seconds}")))?;
         Ok(())
     }
 

@@ -1,9 +1,11 @@
 //! Writing images with the CLI's writers (`.png` tone mapped and sRGB-encoded, `.exr` and `.pfm`
-//! linear), atomically, so a file written from Python has the bytes `lumiere render -o` writes.
+//! linear), atomically, so a file written from Python has the bytes `lumiere render -o` writes;
+//! and the checks of an output that a long render (`lumiere.distributed`) makes before it starts.
 
 use std::path::PathBuf;
 
-use lumiere::image_io::{PngEncoding, PngStyle, Tonemap, write_image as write};
+use lumiere::image_io::{PngEncoding, PngStyle, Tonemap, check_output_path, write_image as write};
+use lumiere::util::write::check_writable;
 use pyo3::prelude::*;
 
 use crate::errors::{OrPyErr, invalid};
@@ -21,15 +23,37 @@ pub fn write_image(
     exposure: f32,
     tonemap: &str,
 ) -> PyResult<()> {
-    if !exposure.is_finite() {
-        return Err(invalid(format!("exposure must be a finite number of stops, got {exposure}")));
+    let style = png_style(exposure, tonemap)?;
+    let pixels = from_bytes(pixels, width as usize * height as usize, "image")?;
+    py.detach(|| write(&path, width, height, &pixels, style)).or_py()
+}
+
+/// Refuses, before a long render, an image output that [`write_image`] would refuse after it: a
+/// format it does not write, a folder that is missing or not writable, an exposure out of range
+/// or an unknown tone mapping.
+#[pyfunction]
+#[pyo3(signature = (path, exposure=0.0, tonemap="aces"))]
+pub fn check_image_output(path: PathBuf, exposure: f32, tonemap: &str) -> PyResult<()> {
+    png_style(exposure, tonemap)?;
+    check_output_path(&path).or_py()
+}
+
+/// Refuses, before a long render, a file (a checkpoint) that could not be written at `path`.
+#[pyfunction]
+pub fn check_writable_output(path: PathBuf) -> PyResult<()> {
+    check_writable(&path).or_py()
+}
+
+/// The PNG style of `exposure` (the CLI's range) and `tonemap`, or the refusal.
+fn png_style(exposure: f32, tonemap: &str) -> PyResult<PngStyle> {
+    if exposure.is_nan() || exposure.abs() > PngStyle::MAX_EXPOSURE {
+        let max = PngStyle::MAX_EXPOSURE;
+        return Err(invalid(format!("exposure must be between -{max} and {max} stops, got {exposure}")));
     }
     let tonemap = match tonemap {
         "aces" => Tonemap::Aces,
         "clamp" => Tonemap::Clamp,
         other => return Err(invalid(format!("unknown tonemap {other:?}: choose aces or clamp"))),
     };
-    let pixels = from_bytes(pixels, width as usize * height as usize, "image")?;
-    let style = PngStyle { encoding: PngEncoding::Srgb, exposure, tonemap };
-    py.detach(|| write(&path, width, height, &pixels, style)).or_py()
+    Ok(PngStyle { encoding: PngEncoding::Srgb, exposure, tonemap })
 }

@@ -90,7 +90,8 @@ impl PyOptions {
         };
         let seconds = |value: Option<f64>, what: &str| -> PyResult<Option<Duration>> {
             value
-                .map(|s| Duration::try_from_secs_f64(s).ok().filter(|d| !d.is_zero()))
+                // As `--time`: any positive number of seconds, however small.
+                .map(|s| Duration::try_from_secs_f64(s).ok().filter(|_| s > 0.0))
                 .map(|d| d.ok_or_else(|| invalid(format!("{what} must be a positive number of seconds"))))
                 .transpose()
         };
@@ -114,8 +115,8 @@ impl PyOptions {
         check(ao_distance.is_some(), "ao_distance", mode == "ao", "ao only");
         check(max_depth.is_some(), "max_depth", mode == "path", "path only");
         options.technique.validate().map_err(crate::errors::to_py)?;
-        if options.noise_target.is_some_and(|n| n.is_nan() || n <= 0.0) {
-            return Err(invalid("noise must be positive"));
+        if options.noise_target.is_some_and(|n| !(n.is_finite() && n > 0.0)) {
+            return Err(invalid("noise must be a positive finite number"));
         }
         Ok(PyOptions { options, ignored })
     }

@@ -134,9 +134,33 @@ def test_a_clear_error_when_no_cluster_is_reachable(tmp_path):
     assert not (tmp_path / "x.pfm").exists()
 
 
-def test_bad_arguments_are_refused_before_connecting():
-    with pytest.raises(lumiere.LumiereError, match="spp must be at least 1"):
+def test_the_command_line_refuses_its_output_and_camera_before_connecting(tmp_path):
+    # Each refusal comes before the (unreachable) cluster is asked for: the render would be lost.
+    base = [sys.executable, "-m", "lumiere.distributed", "render", "--address", "127.0.0.1:9", "--size", "8x6"]
+    for extra, expected in (
+        (["-o", str(tmp_path / "x.jpg")], ".jpg is not an image format"),
+        (["-o", str(tmp_path / "missing" / "x.png")], "No such file or directory"),
+        (["-o", str(tmp_path / "x.png"), "--exposure", "nan"], "exposure must be between -64 and 64 stops"),
+        (["-o", str(tmp_path / "x.png"), "--eye", "0,1,3"], "--eye and --target go together"),
+        (["-o", str(tmp_path / "x.png"), "--emission", "light.001=1,1,1", "--emission", "light.001=2,2,2"],
+         "--emission 'light.001' is given twice"),
+    ):
+        result = subprocess.run(base + extra, capture_output=True, text=True, timeout=120)
+        assert result.returncode == 2, result.stderr
+        assert expected in result.stderr and "no Ray cluster" not in result.stderr, result.stderr
+    assert os.listdir(tmp_path) == []
+
+
+def test_bad_arguments_are_refused_before_connecting(tmp_path):
+    with pytest.raises(lumiere.LumiereError, match="spp must be an integer of at least 1"):
         distributed.render(lumiere.builtin(), spp=0, address="127.0.0.1:9")
+    with pytest.raises(lumiere.LumiereError, match="tasks must be an integer of at least 1, got True"):
+        distributed.render(lumiere.builtin(), spp=2, tasks=True, address="127.0.0.1:9")
+    with pytest.raises(lumiere.LumiereError, match="checkpoint_every must be a finite number of seconds"):
+        distributed.render(lumiere.builtin(), spp=2, checkpoint_every=float("nan"), address="127.0.0.1:9")
+    # A checkpoint that cannot be written is refused now, not after the render it would hold.
+    with pytest.raises(lumiere.LumiereError, match="is a directory"):
+        distributed.render(lumiere.builtin(), spp=2, checkpoint=tmp_path, address="127.0.0.1:9")
     with pytest.raises(lumiere.LumiereError, match="tasks must be an integer of at least 1"):
         distributed.render(lumiere.builtin(), spp=2, tasks=0, address="127.0.0.1:9")
     with pytest.raises(lumiere.LumiereError, match="threads_per_task must be at most 1024"):

@@ -1,6 +1,7 @@
 """lumiere.render: shapes and types, the CLI's exact values, options, errors, progress, the GIL
 and Ctrl-C."""
 
+import os
 import pickle
 import signal
 import subprocess
@@ -222,11 +223,42 @@ def test_numbers_are_checked_as_the_cli_checks_them(tmp_path):
     normals = np.array([[0, 0, 1], [0, 0, 1], [0, float("nan"), 1]], dtype=np.float32)
     with pytest.raises(lumiere.LumiereError, match="normal 2 is not finite"):
         lumiere.Scene.from_arrays(vertices, [[0, 1, 2]], normals=normals)
-    with pytest.raises(lumiere.LumiereError, match="exposure must be a finite number"):
-        lumiere.write_image(tmp_path / "x.png", image, exposure=float("nan"))
+    for exposure in (float("nan"), 64.5, -100):
+        with pytest.raises(lumiere.LumiereError, match="exposure must be between -64 and 64 stops"):
+            lumiere.write_image(tmp_path / "x.png", image, exposure=exposure)
     assert not (tmp_path / "x.png").exists()
     with pytest.raises(lumiere.LumiereError, match="is a directory, not a regular file"):
         lumiere.load(tmp_path)
+
+
+def test_values_the_cli_would_refuse_are_refused(tmp_path):
+    # Strings are sequences, but "111" is not a colour, nor "45" a field of view.
+    with pytest.raises(lumiere.LumiereError, match="must be three numbers"):
+        lumiere.builtin(emission={"light.001": "111"})
+    vertices = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], dtype=np.float32)
+    with pytest.raises(lumiere.LumiereError, match="materials must be a list"):
+        lumiere.Scene.from_arrays(vertices, [[0, 1, 2]], materials="abc")
+    with pytest.raises(lumiere.LumiereError, match="fov must be a number"):
+        lumiere.Camera.look_at((0, 1, 4), (0, 1, 0), fov="45")
+    with pytest.raises(lumiere.LumiereError, match="the field of view must be in"):
+        lumiere.Camera.framing(lumiere.builtin(), fov=0)
+    with pytest.raises(TypeError, match="scene must be a lumiere.Scene"):
+        lumiere.Camera.framing("x")
+    # As --aov, --noise and --time: an AOV once, a finite noise target, a number of seconds.
+    with pytest.raises(lumiere.LumiereError, match="aov 'albedo' is given twice"):
+        lumiere.render(lumiere.builtin(), spp=1, size=(8, 6), aovs=("albedo", "albedo"))
+    with pytest.raises(lumiere.LumiereError, match="noise must be a positive finite number"):
+        lumiere.render(lumiere.builtin(), spp=None, size=(8, 6), noise=float("inf"))
+    with pytest.raises(lumiere.LumiereError, match="time must be a number"):
+        lumiere.render(lumiere.builtin(), spp=None, size=(8, 6), time=True)
+    # A tiny time budget is a budget, as --time 1e-12s is: one pass.
+    assert lumiere.render(lumiere.builtin(), spp=None, size=(8, 6), time=1e-12).shape == (6, 8, 3)
+    # A colour outside [0, 1] is clamped and named, as an MTL's is.
+    scene = lumiere.Scene.from_arrays(vertices, [[0, 1, 2]], materials=[{"name": "m", "kd": (-1, 0.5, 2)}])
+    assert any("clamped to [0, 1]" in w for w in scene.warnings), scene.warnings
+    # Paths as bytes, as os.fspath gives them.
+    lumiere.write_image(os.fsencode(tmp_path / "x.pfm"), np.zeros((2, 2, 3), np.float32))
+    assert (tmp_path / "x.pfm").exists()
 
 
 def test_progress_is_reported_and_an_exception_stops_the_render():

@@ -67,6 +67,13 @@ pub fn shown_path(path: &Path) -> String {
     if text.chars().any(char::is_control) { format!("{text:?}") } else { text.into_owned() }
 }
 
+/// A name (a material's) as messages show it: in single quotes when it prints on one line,
+/// otherwise escaped and double-quoted, so that a name given with a newline or a terminal escape
+/// (`--emission "$(printf 'a\nb')=1,1,1"`) cannot split a message or reach the terminal raw.
+pub fn shown_name(name: &str) -> String {
+    if name.chars().any(char::is_control) { format!("{name:?}") } else { format!("'{name}'") }
+}
+
 impl std::error::Error for Error {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {

@@ -42,7 +42,10 @@ impl Tonemap {
         match self {
             Tonemap::Clamp => c,
             Tonemap::Aces => {
-                let x = 0.6 * c.max(0.0);
+                // The curve passes 1 near x = 7.24 and stays above it: capping x at 16 changes
+                // no result but keeps its squares finite (from x ~ 1e19 they overflowed, and
+                // inf / inf turned the brightest pixels black).
+                let x = (0.6 * c.max(0.0)).min(16.0);
                 (x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14)).clamp(0.0, 1.0)
             }
         }
@@ -56,6 +59,12 @@ pub struct PngStyle {
     /// Exposure in stops (EV): each +1 doubles the radiance before tone mapping.
     pub exposure: f32,
     pub tonemap: Tonemap,
+}
+
+impl PngStyle {
+    /// The widest exposure either way, in stops: `2^64` brings the faintest normal radiance an
+    /// f32 holds near 1, and takes the brightest far past white.
+    pub const MAX_EXPOSURE: f32 = 64.0;
 }
 
 impl From<PngEncoding> for PngStyle {

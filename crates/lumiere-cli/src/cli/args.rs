@@ -3,6 +3,7 @@ use std::path::PathBuf;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use glam::Vec3;
 use lumiere::accel::Isa;
+use lumiere::image_io::PngStyle;
 use lumiere::render::aov::Aov;
 
 #[derive(Parser, Debug)]
@@ -32,12 +33,12 @@ pub struct BenchSamplerArgs {
     #[arg(long, value_parser = parse_size, default_value = "256x192")]
     pub size: (u32, u32),
 
-    /// Samples of the converged reference image.
-    #[arg(long, default_value_t = 8192)]
+    /// Samples of the converged reference image (1 to 65536).
+    #[arg(long, default_value_t = 8192, value_parser = parse_reference_samples)]
     pub reference_samples: u32,
 
-    /// Seeds averaged per measurement.
-    #[arg(long, default_value_t = 4)]
+    /// Seeds averaged per measurement (1 to 1000).
+    #[arg(long, default_value_t = 4, value_parser = parse_seeds)]
     pub seeds: u64,
 }
 
@@ -351,13 +352,35 @@ fn parse_repeats(s: &str) -> Result<usize, String> {
     }
 }
 
+/// The reference's samples per pixel (per light triangle, or AO directions): at least one, and
+/// few enough that a reference finishes (65536 take hours at the default size).
+fn parse_reference_samples(s: &str) -> Result<u32, String> {
+    match s.trim().parse::<u32>() {
+        Ok(value @ 1..=65536) => Ok(value),
+        _ => Err(format!("expected a number of samples from 1 to 65536, got {s:?}")),
+    }
+}
+
+/// Seeds averaged by `bench-sampler`: at least one (no seed has no error to average).
+fn parse_seeds(s: &str) -> Result<u64, String> {
+    match s.trim().parse::<u64>() {
+        Ok(value @ 1..=1000) => Ok(value),
+        _ => Err(format!("expected a number of seeds from 1 to 1000, got {s:?}")),
+    }
+}
+
 fn parse_aov(s: &str) -> Result<Aov, String> {
     Aov::parse(s.trim()).map_err(|e| e.to_string())
 }
 
 fn parse_exposure(s: &str) -> Result<f32, String> {
     let value = parse_finite(s)?;
-    if value.abs() <= 64.0 { Ok(value as f32) } else { Err(format!("an exposure between -64 and 64 stops, got {s:?}")) }
+    let max = PngStyle::MAX_EXPOSURE;
+    if value.abs() <= f64::from(max) {
+        Ok(value as f32)
+    } else {
+        Err(format!("an exposure between -{max} and {max} stops, got {s:?}"))
+    }
 }
 
 fn parse_fov(s: &str) -> Result<f32, String> {

@@ -6,7 +6,7 @@ use crate::bench::bvh::{build, median_seconds, mesh_bytes, mismatches, peak_rss_
 use crate::bench::rays::make_ray_sets;
 use crate::bench::scenes::BenchScene;
 use lumiere::accel::{BuildPreset, Bvh};
-use lumiere::util::write::write_atomically;
+use lumiere::util::write::{check_writable, write_atomically};
 use lumiere::world::World;
 use lumiere::{Error, Result};
 
@@ -17,6 +17,10 @@ use super::pool;
 
 pub fn run(args: &BenchBvhArgs) -> Result<()> {
     let isa = super::isa::choose(args.isa)?;
+    // Refused now, not after minutes of measurement.
+    if let Some(path) = &args.json {
+        check_writable(path)?;
+    }
     let scenes: Vec<BenchScene> = args
         .scenes
         .split(',')

@@ -6,7 +6,7 @@ use lumiere::integrators::{AmbientOcclusion, Direct, LightSampling, Shadows, Tec
 use lumiere::render::{RenderOptions, render};
 use lumiere::scene::camera::Camera;
 use lumiere::scene::{Scene, builtin};
-use lumiere::util::write::write_atomically;
+use lumiere::util::write::{check_writable, write_atomically};
 use lumiere::world::World;
 use lumiere::{Error, Result};
 
@@ -68,6 +68,10 @@ const LAB_ROWS: [LabRow; 7] = [
 ];
 
 pub fn run(args: &BenchLabArgs) -> Result<()> {
+    // Refused now, not after minutes of measurement.
+    if let Some(path) = &args.json {
+        check_writable(path)?;
+    }
     let (width, height, repeats) =
         if args.quick { (256, 192, 1) } else { (builtin::WIDTH, builtin::HEIGHT, args.repeats) };
     let world = World::with_isa(Scene::builtin()?, Default::default(), super::isa::choose(args.isa)?);

@@ -173,7 +173,9 @@ fn assert_refused(dir: &TempDir, args: &[&str], expected: &str) {
 
 /// Refused before any work, and with a message instead of an abort: an AOV asked twice (an EXR
 /// cannot hold it), a benchmark's JSON that is not a `.json` file (`--json scene.obj` replaced the
-/// scene), repetitions whose times do not fit in memory, and more threads than `render` allows.
+/// scene) or that cannot be written (it was refused after the whole benchmark), repetitions whose
+/// times do not fit in memory, more threads than `render` allows, and a sampler benchmark with no
+/// seed (it printed a table of NaN) or no reference sample.
 #[test]
 fn bad_outputs_and_counts_are_refused_before_the_work() {
     let dir = TempDir::new("refused-early");
@@ -189,10 +191,15 @@ fn bad_outputs_and_counts_are_refused_before_the_work() {
         (vec!["bench", "--repeats", "4294967296"], "from 1 to 1000"),
         (vec!["bench", "--repeats", "0"], "from 1 to 1000"),
         (vec!["bench-bvh", "--scenes", "cornell", "--threads", "100000"], "at most 1024 threads"),
+        (vec!["bench", "--quick", "--json", &dir.arg("missing/x.json")], "No such file or directory"),
+        (vec!["bench-bvh", "--scenes", "cornell", "--json", &dir.arg("missing/x.json")], "No such file or directory"),
+        (vec!["bench-sampler", "--size", "4x3", "--seeds", "0"], "from 1 to 1000"),
+        (vec!["bench-sampler", "--size", "4x3", "--reference-samples", "0"], "from 1 to 65536"),
     ] {
         let out = run(&args);
         assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
         assert!(stderr(&out).contains(expected), "{args:?}: {}", stderr(&out));
+        assert!(out.stdout.is_empty(), "{args:?} printed before refusing: {}", String::from_utf8_lossy(&out.stdout));
     }
     assert_eq!(fs::read(dir.path("scene.obj")).unwrap(), b"v 0 0 0\n");
 }
@@ -257,6 +264,33 @@ fn long_output_names_are_written() {
 
 // ---------------------------------------------------------------------------------------------
 // Flags
+
+/// `--emission` names a material once (two values for it: which was meant?), and a name with a
+/// newline or a terminal escape is shown escaped, on one line.
+#[test]
+fn emission_names_are_given_once_and_shown_on_one_line() {
+    let dir = TempDir::new("emission-names");
+    let out = dir.arg("o.png");
+    let twice =
+        ["render", "--size", "8x6", "--emission", "light.001=1,1,1", "--emission", "light.001=2,2,2", "-o", &out];
+    assert_refused(&dir, &twice, "--emission 'light.001' is given twice");
+    assert_refused(
+        &dir,
+        &["render", "--size", "8x6", "--emission", "a\nb=1,1,1", "-o", &out],
+        r#"no material named "a\nb""#,
+    );
+    assert_refused(&dir, &["render", "--size", "8x6", "--emission", "z\u{1b}[2J=1,1,1", "-o", &out], r#""z\u{1b}[2J""#);
+}
+
+/// A field of view too narrow to frame a scene from a finite distance is named, not taken for
+/// bounds too large to frame.
+#[test]
+fn a_field_of_view_too_narrow_to_frame_is_named() {
+    let dir = TempDir::new("narrow-fov");
+    fs::write(dir.path("t.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let args = ["render", &dir.arg("t.obj"), "--fov", "1e-40", "--size", "8x6", "-o", &dir.arg("o.png")];
+    assert_refused(&dir, &args, "a field of view of 1e-40 degrees is too narrow to frame it; give --eye and --target");
+}
 
 #[test]
 fn numeric_flags_out_of_range_are_refused() {

@@ -50,7 +50,7 @@ def write_image(path: str, image: "object", exposure: float = 0.0, tonemap: str 
     if array.ndim != 3 or array.shape[2] != 3:
         raise LumiereError(f"image must have shape (height, width, 3), got {array.shape}")
     height, width = array.shape[:2]
-    _write_image(os.fspath(path), width, height, array.tobytes(), exposure, tonemap)
+    _write_image(os.fsdecode(os.fspath(path)), width, height, array.tobytes(), exposure, tonemap)
 
 
 from ._lumiere import write_image as _write_image  # noqa: E402

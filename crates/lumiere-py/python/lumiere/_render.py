@@ -57,6 +57,9 @@ def _options(
         raise TypeError(
             f"render() got unexpected keyword arguments {sorted(unknown)}; technique options are {', '.join(TECHNIQUE_OPTIONS)}"
         )
+    for name, value in (("time", time), ("noise", noise)):
+        if isinstance(value, (bool, np.bool_, str, bytes)):
+            raise LumiereError(f"{name} must be a number, got {value!r}")
     seed = _integer(seed, "seed", 0, 2**64 - 1)
     # 2**32 - 1 is the native side's "until a budget stops it", which spp=None asks for.
     spp = None if spp is None else _integer(spp, "spp", 1, 2**32 - 2)
@@ -111,6 +114,10 @@ def render_full(
     if isinstance(aovs, str):
         aovs = (aovs,)
     aovs = tuple(aovs)
+    # An EXR cannot hold a channel twice, and the CLI refuses it: so does this.
+    twice = next((name for i, name in enumerate(aovs) if name in aovs[:i]), None)
+    if twice is not None:
+        raise LumiereError(f"aov {twice!r} is given twice")
     image, buffers, stats = _lumiere.render(
         scene._native, camera._native, options, _threads(threads), list(aovs), progress
     )

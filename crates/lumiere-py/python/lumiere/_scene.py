@@ -32,10 +32,28 @@ def _emission_list(emission: Optional[Mapping[str, Vector]]) -> list:
 
 def _vector(value: Any, what: str) -> Tuple[float, float, float]:
     try:
+        # A string is a sequence too: "111" is not (1, 1, 1).
+        if isinstance(value, (str, bytes)) or any(isinstance(v, (str, bytes)) for v in value):
+            raise TypeError
         x, y, z = (float(v) for v in value)
     except (TypeError, ValueError):
         raise LumiereError(f"{what} must be three numbers, got {value!r}") from None
     return (x, y, z)
+
+
+def _number(value: Any, what: str) -> float:
+    """``value`` as a float, if it is a number (not a bool, not a string such as "45")."""
+    if isinstance(value, (bool, np.bool_, str, bytes)):
+        raise LumiereError(f"{what} must be a number, got {value!r}")
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        raise LumiereError(f"{what} must be a number, got {value!r}") from None
+
+
+def _path(path: Any) -> str:
+    """A path given as ``str``, ``bytes`` or ``os.PathLike``, as the ``str`` the native side takes."""
+    return os.fsdecode(os.fspath(path))
 
 
 def _integer(value: Any, what: str, low: int, high: int) -> int:
@@ -102,6 +120,8 @@ class Scene:
         if triangles.size and (triangles.min() < 0 or triangles.max() >= len(vertices)):
             raise LumiereError(f"triangles index vertices 0..{len(vertices) - 1}, found {triangles.min()}..{triangles.max()}")
         triangles = np.ascontiguousarray(triangles, dtype=np.uint32)
+        if isinstance(materials, (str, bytes)):
+            raise LumiereError(f"materials must be a list of names or dicts, got {materials!r}")
         specs = []
         for index, material in enumerate(materials if materials is not None else ["default"]):
             if isinstance(material, str):
@@ -208,7 +228,7 @@ def load(path: PathLike, emission: Optional[Mapping[str, Vector]] = None) -> Sce
     :raises LumiereOSError: the file cannot be read.
     :raises LumiereError: the file is malformed (the message names the file and line).
     """
-    path = os.path.abspath(os.fspath(path))
+    path = os.path.abspath(_path(path))
     emission = _emission_list(emission)
     return Scene(_lumiere.NativeScene.load(path, emission), ("load", path, emission))
 
@@ -243,13 +263,13 @@ class Camera:
     ) -> "Camera":
         """A pinhole at ``eye`` looking at ``target``, ``fov`` the vertical field of view in degrees
         (``--eye/--target/--up/--fov`` of the CLI)."""
-        args = (_vector(eye, "eye"), _vector(target, "target"), _vector(up, "up"), float(fov), *_size(size))
+        args = (_vector(eye, "eye"), _vector(target, "target"), _vector(up, "up"), _number(fov, "fov"), *_size(size))
         return cls(_lumiere.NativeCamera.look_at(*args), ("look_at", args))
 
     @classmethod
     def orbiter(cls, path: PathLike, size: Tuple[int, int] = DEFAULT_SIZE) -> "Camera":
         """gKit's orbiter camera from an orbiter file (``--orbiter``)."""
-        path = os.fspath(path)
+        path = _path(path)
         try:
             with open(path, "rb") as file:
                 text = file.read()
@@ -272,7 +292,9 @@ class Camera:
     ) -> "Camera":
         """A look-at view from +z that frames the whole scene: the CLI's camera for a scene file
         given without one."""
-        eye, target = _lumiere.NativeCamera.framing(scene._native, float(fov))
+        if not isinstance(scene, Scene):
+            raise TypeError(f"scene must be a lumiere.Scene, got {type(scene).__name__}")
+        eye, target = _lumiere.NativeCamera.framing(scene._native, _number(fov, "fov"))
         return cls.look_at(eye, target, up, fov, size)
 
     @property

@@ -253,17 +253,24 @@ impl Camera {
 
 /// The eye and target of a view from +z that frames all of `bounds` (its bounding sphere fills the
 /// vertical field of view `fov_degrees`): the camera front ends use when none is given. Refused,
-/// with the reason, for empty bounds or bounds too large to frame in `f32`.
-pub fn framing(bounds: &Aabb, fov_degrees: f32) -> std::result::Result<(Vec3, Vec3), &'static str> {
+/// with the reason, for empty bounds, a field of view out of range or too narrow to frame them
+/// from a finite distance, or bounds too large to frame in `f32`.
+pub fn framing(bounds: &Aabb, fov_degrees: f32) -> std::result::Result<(Vec3, Vec3), String> {
     if bounds.is_empty() {
-        return Err("no vertices to frame");
+        return Err("no vertices to frame".into());
+    }
+    if !(fov_degrees > 0.0 && fov_degrees < 180.0) {
+        return Err(format!("the field of view must be in (0, 180) degrees, got {fov_degrees:?}"));
     }
     let radius = 0.5 * bounds.extent().length();
     let distance = radius / (0.5 * fov_degrees.to_radians()).sin();
     let target = bounds.center();
+    if radius.is_finite() && target.is_finite() && !distance.is_finite() {
+        return Err(format!("a field of view of {fov_degrees:?} degrees is too narrow to frame it"));
+    }
     let eye = target + Vec3::Z * distance.max(1e-6);
     if !(eye.is_finite() && target.is_finite()) || eye == target {
-        return Err("its bounds are too large (or too far from the origin) to frame automatically");
+        return Err("its bounds are too large (or too far from the origin) to frame automatically".into());
     }
     Ok((eye, target))
 }

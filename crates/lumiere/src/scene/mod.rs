@@ -10,7 +10,7 @@ use std::path::Path;
 
 use glam::Vec3;
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, shown_name};
 use crate::materials::Material;
 use crate::math::Aabb;
 use mesh::TriangleMesh;
@@ -45,8 +45,8 @@ impl Scene {
     pub fn from_parts(
         name: String,
         mesh: TriangleMesh,
-        materials: Vec<Material>,
-        warnings: Vec<String>,
+        mut materials: Vec<Material>,
+        mut warnings: Vec<String>,
     ) -> Result<Scene> {
         if let Some(bad) = mesh.material_ids.iter().find(|&&m| m as usize >= materials.len()) {
             return Err(Error::invalid(format!("{name}: material id {bad} out of range")));
@@ -67,12 +67,29 @@ impl Scene {
         }
         if let Some(bad) = materials.iter().find(|m| !m.kd.is_finite()) {
             return Err(Error::invalid(format!(
-                "{name}: material '{}': colour {} {} {} must be finite",
-                bad.name, bad.kd.x, bad.kd.y, bad.kd.z
+                "{name}: material {}: colour {} {} {} must be finite",
+                shown_name(&bad.name),
+                bad.kd.x,
+                bad.kd.y,
+                bad.kd.z
             )));
         }
         if let Some(bad) = mesh.normals.iter().position(|n| !n.is_finite()) {
             return Err(Error::invalid(format!("{name}: normal {bad} is not finite")));
+        }
+        // A reflectance outside [0, 1] would reflect more light than arrives (or take some away):
+        // every lobe that reads `kd` (diffuse, a metal's base colour) gets it clamped, once, named.
+        for material in &mut materials {
+            let clamped = material.kd.clamp(Vec3::ZERO, Vec3::ONE);
+            if clamped != material.kd {
+                let Vec3 { x, y, z } = material.kd;
+                warnings.push(format!(
+                    "{name}: material {}: colour {x} {y} {z} clamped to [0, 1] (a surface reflects at most the \
+                     light it receives)",
+                    shown_name(&material.name)
+                ));
+                material.kd = clamped;
+            }
         }
         Ok(Scene { name, mesh, materials, warnings, sources: Vec::new() })
     }
@@ -86,7 +103,7 @@ impl Scene {
             found = true;
         }
         if !found {
-            return Err(Error::invalid(format!("{}: no material named '{name}'", self.name)));
+            return Err(Error::invalid(format!("{}: no material named {}", self.name, shown_name(name))));
         }
         Ok(())
     }
@@ -109,7 +126,10 @@ fn check_emission(scene: &str, material: &str, ke: Vec3) -> Result<()> {
         return Ok(());
     }
     Err(Error::invalid(format!(
-        "{scene}: material '{material}': emission {} {} {} must be finite and not negative",
-        ke.x, ke.y, ke.z
+        "{scene}: material {}: emission {} {} {} must be finite and not negative",
+        shown_name(material),
+        ke.x,
+        ke.y,
+        ke.z
     )))
 }

@@ -7,7 +7,7 @@ use std::path::Path;
 use crate::common::TempDir;
 use glam::Vec3;
 use lumiere::Error;
-use lumiere::image_io::{PngEncoding, check_output_path, linear_to_srgb8, write_image};
+use lumiere::image_io::{PngEncoding, PngStyle, Tonemap, check_output_path, linear_to_srgb8, write_image};
 use lumiere::util::write::{remove_stale_temporaries, write_atomically};
 
 /// The reference: IEC 61966-2-1 in f64, rounded to nearest.
@@ -65,6 +65,30 @@ fn png_srgb_round_trip_values_and_row_order() {
     assert_eq!(px(2, 1), [0, 255, 0], "NaN -> 0, +inf -> 255, negative -> 0");
     assert_eq!(px(3, 1), [0, 0, 0]);
     assert_eq!(dir.entries(), ["out.png"]);
+}
+
+/// The filmic curve rises with radiance and saturates to white, however bright or exposed the
+/// pixel: from about 1e19 its squares overflowed, and inf / inf turned the brightest pixels black.
+#[test]
+fn aces_rises_to_white_and_never_turns_black() {
+    let dir = TempDir::new("png-aces");
+    let path = dir.path("out.png");
+    let radiance = [0.0, 0.01, 0.18, 1.0, 4.0, 12.0, 100.0, 1e19, 1e30, f32::MAX, f32::INFINITY];
+    let pixels: Vec<Vec3> = radiance.iter().map(|&c| g(c)).collect();
+    let width = pixels.len() as u32;
+    let grey = |exposure: f32| {
+        let style = PngStyle { encoding: PngEncoding::Srgb, exposure, tonemap: Tonemap::Aces };
+        write_image(&path, width, 1, &pixels, style).expect("write png");
+        let img = image::open(&path).expect("decode png").to_rgb8();
+        (0..width).map(|x| img.get_pixel(x, 0).0[0]).collect::<Vec<u8>>()
+    };
+    let plain = grey(0.0);
+    assert_eq!(plain[0], 0);
+    assert!(plain.windows(2).all(|w| w[0] <= w[1]), "not rising: {plain:?}");
+    assert!(plain[3] > 100 && plain[3] < 255, "radiance 1 is mid-grey, not white: {plain:?}");
+    assert!(plain[5..].iter().all(|&v| v == 255), "bright pixels are white: {plain:?}");
+    let exposed = grey(PngStyle::MAX_EXPOSURE);
+    assert!(exposed[1..].iter().all(|&v| v == 255), "every lit pixel is white at +64 stops: {exposed:?}");
 }
 
 #[test]

@@ -232,6 +232,22 @@ fn missing_mtl_warns_and_uses_grey() {
     );
 }
 
+/// A colour outside [0, 1] would reflect more light than arrives, or take some away: the scene
+/// keeps it clamped, with one warning naming the material; colours in range are kept as given.
+#[test]
+fn colours_outside_zero_to_one_are_clamped_and_named() {
+    let dir = TempDir::new("kd-range");
+    dir.write("m.mtl", "newmtl hot\nKd -1 0.5 2\nnewmtl fine\nKd 0 0.25 1\n");
+    let obj = dir.write("t.obj", format!("mtllib m.mtl\n{SQUARE}usemtl hot\nf 1 2 3\nusemtl fine\nf 1 3 4\n"));
+    let scene = lumiere::scene::Scene::load(&obj).expect("load");
+    let kd = |name: &str| scene.materials.iter().find(|m| m.name == name).unwrap().kd;
+    assert_eq!(kd("hot"), Vec3::new(0.0, 0.5, 1.0));
+    assert_eq!(kd("fine"), Vec3::new(0.0, 0.25, 1.0));
+    let named: Vec<&String> = scene.warnings.iter().filter(|w| w.contains("clamped to [0, 1]")).collect();
+    assert_eq!(named.len(), 1, "{:?}", scene.warnings);
+    assert!(named[0].contains("material 'hot': colour -1 0.5 2"), "{}", named[0]);
+}
+
 #[test]
 fn broken_mtl_lines_warn_and_the_rest_is_kept() {
     let mtl = "Kd 1 1 1\nnewmtl a\nKd 0.5 zero 0.5\nKs 0.1\nNs 12 13\nillum x\nnewmtl b\nKe inf 0 0\nKd 0 1 0\n";

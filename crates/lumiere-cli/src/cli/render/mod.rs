@@ -14,7 +14,7 @@ use std::time::Instant;
 use glam::Vec3;
 use lumiere::Result;
 use lumiere::accel::BuildPreset;
-use lumiere::error::{Error, shown_path};
+use lumiere::error::{Error, shown_name, shown_path};
 use lumiere::image_io::{ExrLayer, PngEncoding, PngStyle, Tonemap, write_exr_with_layers, write_image};
 use lumiere::render::aov::{Aov, render_aovs};
 use lumiere::render::film::Film;
@@ -118,6 +118,13 @@ fn nothing_rendered(args: &RenderArgs, output: &RenderOutput) -> Result<u8> {
 
 /// The scene file or the built-in scene, with `--emission` applied and load warnings shown.
 fn load_scene(args: &RenderArgs) -> Result<Scene> {
+    // Two values for one material, refused before loading: which one was meant?
+    let emission = &args.emission;
+    if let Some((_, (name, _))) =
+        emission.iter().enumerate().find(|(i, (a, _))| emission[..*i].iter().any(|(b, _)| a == b))
+    {
+        return Err(Error::invalid(format!("--emission {} is given twice", shown_name(name))));
+    }
     let mut scene = match &args.scene {
         Some(path) => Scene::load(path)?,
         None => Scene::builtin()?,

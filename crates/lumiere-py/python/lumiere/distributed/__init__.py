@@ -17,6 +17,7 @@ Needs Ray: ``pip install 'lumiere[ray]'``. See docs/DISTRIBUTED.md for measureme
 from __future__ import annotations
 
 import math
+import operator
 import os
 import socket
 import time
@@ -115,6 +116,17 @@ def _render_range(
     }
 
 
+def _integer(name: str, value: Any, least: int, why: str = "") -> int:
+    """``value`` as an int (numpy integers too, bools not) of at least ``least``, or the refusal."""
+    try:
+        number = None if isinstance(value, bool) else operator.index(value)
+    except TypeError:
+        number = None
+    if number is None or number < least:
+        raise LumiereError(f"{name} must be an integer of at least {least}, got {value!r}{why}")
+    return number
+
+
 def render_full(
     scene: Scene,
     camera: Optional[Camera] = None,
@@ -138,11 +150,16 @@ def render_full(
     pass, passes, worker wall and CPU seconds, host and pid; ``seconds``: the driver's wall time)."""
     if not isinstance(scene, Scene):
         raise TypeError(f"scene must be a lumiere.Scene, got {type(scene).__name__}")
-    if not isinstance(spp, int) or spp < 1:
-        raise LumiereError(f"spp must be at least 1, got {spp!r} (a distributed render does a fixed number of passes)")
-    for name, value, least in (("tasks", tasks, 1), ("threads_per_task", threads_per_task, 1), ("max_retries", max_retries, 0)):
-        if value is not None and (not isinstance(value, int) or value < least):
-            raise LumiereError(f"{name} must be an integer of at least {least}, got {value!r}")
+    spp = _integer("spp", spp, 1, " (a distributed render does a fixed number of passes)")
+    tasks = None if tasks is None else _integer("tasks", tasks, 1)
+    threads_per_task = _integer("threads_per_task", threads_per_task, 1)
+    max_retries = _integer("max_retries", max_retries, 0)
+    if not (isinstance(checkpoint_every, (int, float)) and not isinstance(checkpoint_every, bool)
+            and math.isfinite(checkpoint_every) and checkpoint_every >= 0):
+        raise LumiereError(f"checkpoint_every must be a finite number of seconds, at least 0, got {checkpoint_every!r}")
+    # Refused now, not once the render is done and the checkpoint cannot hold it.
+    if checkpoint is not None:
+        _lumiere.check_writable_output(os.fspath(checkpoint))
     # Refused here, before connecting, rather than by every worker's thread pool.
     if threads_per_task is not None and threads_per_task > 1024:
         raise LumiereError(f"threads_per_task must be at most 1024 (as --threads), got {threads_per_task}")

@@ -8,7 +8,7 @@ import argparse
 import sys
 from typing import List, Optional
 
-from .. import Camera, LumiereError, builtin, load, write_image
+from .. import Camera, LumiereError, _lumiere, builtin, load, write_image
 from . import ClusterUnreachable, render_full
 
 #: ``lumiere render``'s exit code for bad input.
@@ -71,6 +71,14 @@ def parser() -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
+    # Refused now, not once the render is done (`lumiere render` checks its output first too).
+    _lumiere.check_image_output(args.output, args.exposure, _tonemap(args.mode))
+    if (args.eye is None) != (args.target is None):
+        raise LumiereError("--eye and --target go together")
+    names = [name for name, _ in args.emission]
+    twice = next((name for i, name in enumerate(names) if name in names[:i]), None)
+    if twice is not None:
+        raise LumiereError(f"--emission {twice!r} is given twice")
     emission = dict(args.emission)
     scene = load(args.scene, emission) if args.scene else builtin(emission)
     if args.orbiter:
@@ -109,7 +117,7 @@ def run(args: argparse.Namespace) -> int:
         resume=args.resume,
         **technique,
     )
-    write_image(args.output, result.image, args.exposure, "aces" if args.mode == "path" else "clamp")
+    write_image(args.output, result.image, args.exposure, _tonemap(args.mode))
     stats = result.stats
     print(
         f"{args.output}: {camera.width}x{camera.height}, {stats['samples']} spp, {len(stats['tasks'])} tasks on "
@@ -117,6 +125,11 @@ def run(args: argparse.Namespace) -> int:
         file=sys.stderr,
     )
     return 0
+
+
+def _tonemap(mode: str) -> str:
+    """``lumiere render``'s tone mapping for a mode's PNG: filmic for path tracing."""
+    return "aces" if mode == "path" else "clamp"
 
 
 def main(argv: Optional[List[str]] = None) -> int:
