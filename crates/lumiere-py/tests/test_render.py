@@ -238,6 +238,8 @@ def test_values_the_cli_would_refuse_are_refused(tmp_path):
     vertices = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], dtype=np.float32)
     with pytest.raises(lumiere.LumiereError, match="materials must be a list"):
         lumiere.Scene.from_arrays(vertices, [[0, 1, 2]], materials="abc")
+    with pytest.raises(lumiere.LumiereError, match="eye must fit in float32"):
+        lumiere.Camera.look_at((1e39, 1, 4), (0, 1, 0))
     with pytest.raises(lumiere.LumiereError, match="fov must be a number"):
         lumiere.Camera.look_at((0, 1, 4), (0, 1, 0), fov="45")
     with pytest.raises(lumiere.LumiereError, match="the field of view must be in"):

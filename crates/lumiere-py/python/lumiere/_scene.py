@@ -3,6 +3,7 @@ that they pickle (Ray ships them to workers, which rebuild them) and print helpf
 
 from __future__ import annotations
 
+import math
 import os
 import uuid
 from collections import OrderedDict
@@ -21,6 +22,9 @@ Vector = Sequence[float]
 #: The image size of the lab (and of ``lumiere render``): 1024x768, as (width, height).
 DEFAULT_SIZE: Tuple[int, int] = (1024, 768)
 
+#: The largest finite float32: the native side's numbers.
+_F32_MAX = float(np.finfo(np.float32).max)
+
 
 def _emission_list(emission: Optional[Mapping[str, Vector]]) -> list:
     if emission is None:
@@ -38,6 +42,10 @@ def _vector(value: Any, what: str) -> Tuple[float, float, float]:
         x, y, z = (float(v) for v in value)
     except (TypeError, ValueError):
         raise LumiereError(f"{what} must be three numbers, got {value!r}") from None
+    # The native side stores float32: a finite number beyond its range would arrive as infinity
+    # and be refused under another name (infinity and NaN are left to its own checks).
+    if any(math.isfinite(v) and abs(v) > _F32_MAX for v in (x, y, z)):
+        raise LumiereError(f"{what} must fit in float32 (at most {_F32_MAX:.7g} in magnitude), got {value!r}")
     return (x, y, z)
 
 
