@@ -6,7 +6,10 @@ use std::process::ExitCode;
 use lumiere_cli::cli::{self, output};
 
 fn main() -> ExitCode {
-    let args = <cli::Cli as clap::Parser>::parse();
+    let args = match <cli::Cli as clap::Parser>::try_parse() {
+        Ok(args) => args,
+        Err(e) => return refuse_arguments(e),
+    };
     match cli::run(args) {
         Ok(code) => ExitCode::from(code),
         // The reader of stdout went away (`lumiere info x.obj | head -1`): nothing left to say.
@@ -16,4 +19,31 @@ fn main() -> ExitCode {
             ExitCode::from(2)
         }
     }
+}
+
+/// Help and version go out as clap writes them; a bad argument is one line, as every other refusal
+/// (clap's own message spreads over up to six, with a usage line and a pointer to `--help`): its
+/// lines of substance joined, exit code 2.
+fn refuse_arguments(e: clap::Error) -> ExitCode {
+    use clap::error::ErrorKind;
+    if matches!(
+        e.kind(),
+        ErrorKind::DisplayHelp | ErrorKind::DisplayVersion | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
+    ) {
+        e.exit();
+    }
+    let text = e.render().to_string();
+    let line = text
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty() && !l.starts_with("Usage:") && !l.starts_with("For more information"))
+        .map(|l| l.strip_prefix("error: ").unwrap_or(l))
+        .fold(String::new(), |line, piece| match line.as_str() {
+            "" => piece.to_string(),
+            // "...not provided:" goes on with what was not.
+            _ if line.ends_with(':') => format!("{line} {piece}"),
+            _ => format!("{line}; {piece}"),
+        });
+    let _ = writeln!(std::io::stderr().lock(), "lumiere: error: {line} (see --help)");
+    ExitCode::from(2)
 }

@@ -294,7 +294,7 @@ fn a_field_of_view_too_narrow_to_frame_is_named() {
 
 #[test]
 fn numeric_flags_out_of_range_are_refused() {
-    let cases: [(&[&str], &str); 12] = [
+    let cases: [(&[&str], &str); 15] = [
         (&["--fov", "0"], "between 0 and 180"),
         // The library's "unlimited": it would render without end.
         (&["--spp", "4294967295"], "not in 1..=4294967294"),
@@ -308,12 +308,17 @@ fn numeric_flags_out_of_range_are_refused() {
         (&["--checkpoint-every", "-1"], "must not be negative"),
         (&["--noise", "0"], "positive"),
         (&["--eye", "1e38,0,0", "--target", "-3e38,0,0"], "too far apart"),
+        // What clap refuses is one line too, as every other refusal.
+        (&["--eye", "0,1,3"], "the following required arguments were not provided: --target <TARGET>"),
+        (&["--bogus"], "unexpected argument '--bogus' found"),
+        (&["--mode", "xyz"], "invalid value 'xyz' for '--mode <MODE>'; [possible values: hits,"),
     ];
     let dir = TempDir::new("flags");
     for (flags, expected) in cases {
         let out = run(&[&["render", "--size", "8x6", "-o", &dir.arg("o.png")][..], flags].concat());
         assert_eq!(out.status.code(), Some(2), "{flags:?}: {}", stderr(&out));
         assert!(stderr(&out).contains(expected), "{flags:?}: expected {expected:?} in {}", stderr(&out));
+        assert_eq!(stderr(&out).trim_end().lines().count(), 1, "{flags:?}: not one line: {}", stderr(&out));
         assert!(dir.entries().is_empty(), "{flags:?} wrote a file");
     }
     // An exponent in a duration is a number, not a unit.
