@@ -9,7 +9,7 @@ from typing import Any, Callable, Dict, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from . import _lumiere
-from ._scene import DEFAULT_SIZE, Camera, Scene, _integer
+from ._scene import DEFAULT_SIZE, Camera, Scene, _first_repeat, _integer, _number
 from .errors import LumiereError
 
 __all__ = ["render", "render_full", "RenderResult", "MODES", "AOVS", "TECHNIQUE_OPTIONS"]
@@ -57,9 +57,8 @@ def _options(
         raise TypeError(
             f"render() got unexpected keyword arguments {sorted(unknown)}; technique options are {', '.join(TECHNIQUE_OPTIONS)}"
         )
-    for name, value in (("time", time), ("noise", noise)):
-        if isinstance(value, (bool, np.bool_, str, bytes)):
-            raise LumiereError(f"{name} must be a number, got {value!r}")
+    time = None if time is None else _number(time, "time")
+    noise = None if noise is None else _number(noise, "noise")
     seed = _integer(seed, "seed", 0, 2**64 - 1)
     # 2**32 - 1 is the native side's "until a budget stops it", which spp=None asks for.
     spp = None if spp is None else _integer(spp, "spp", 1, 2**32 - 2)
@@ -115,7 +114,7 @@ def render_full(
         aovs = (aovs,)
     aovs = tuple(aovs)
     # An EXR cannot hold a channel twice, and the CLI refuses it: so does this.
-    twice = next((name for i, name in enumerate(aovs) if name in aovs[:i]), None)
+    twice = _first_repeat(aovs)
     if twice is not None:
         raise LumiereError(f"aov {twice!r} is given twice")
     image, buffers, stats = _lumiere.render(

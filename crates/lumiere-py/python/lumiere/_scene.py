@@ -64,14 +64,24 @@ def _path(path: Any) -> str:
     return os.fsdecode(os.fspath(path))
 
 
-def _integer(value: Any, what: str, low: int, high: int) -> int:
+def _integer(value: Any, what: str, low: int, high: Optional[int] = None) -> int:
     """`value` as an int, if it is an integer (a numpy integer too; not a bool, not a float) in
-    [low, high]: the native side takes fixed-size integers, which must not overflow or truncate."""
+    [low, high] (no upper bound for None): the native side takes fixed-size integers, which must
+    not overflow or truncate."""
+    if high is None:
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or int(value) < low:
+            raise LumiereError(f"{what} must be an integer of at least {low}, got {value!r}")
+        return int(value)
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
         raise LumiereError(f"{what} must be an integer, got {value!r}")
     if not low <= int(value) <= high:
         raise LumiereError(f"{what} must be between {low} and {high}, got {value!r}")
     return int(value)
+
+
+def _first_repeat(items: Sequence[Any]) -> Optional[Any]:
+    """The first item given a second time, or None: an option named twice, which the CLI refuses."""
+    return next((item for i, item in enumerate(items) if item in items[:i]), None)
 
 
 def _size(size: Any) -> Tuple[int, int]:

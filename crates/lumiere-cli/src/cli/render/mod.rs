@@ -119,10 +119,8 @@ fn nothing_rendered(args: &RenderArgs, output: &RenderOutput) -> Result<u8> {
 /// The scene file or the built-in scene, with `--emission` applied and load warnings shown.
 fn load_scene(args: &RenderArgs) -> Result<Scene> {
     // Two values for one material, refused before loading: which one was meant?
-    let emission = &args.emission;
-    if let Some((_, (name, _))) =
-        emission.iter().enumerate().find(|(i, (a, _))| emission[..*i].iter().any(|(b, _)| a == b))
-    {
+    let names: Vec<&String> = args.emission.iter().map(|(name, _)| name).collect();
+    if let Some(name) = first_repeat(&names) {
         return Err(Error::invalid(format!("--emission {} is given twice", shown_name(name))));
     }
     let mut scene = match &args.scene {
@@ -136,6 +134,11 @@ fn load_scene(args: &RenderArgs) -> Result<Scene> {
         output::warn(format_args!("{warning}"));
     }
     Ok(scene)
+}
+
+/// The first item given a second time (an option that names one thing twice).
+fn first_repeat<T: PartialEq>(items: &[T]) -> Option<&T> {
+    items.iter().enumerate().find(|(i, item)| items[..*i].contains(item)).map(|(_, item)| item)
 }
 
 /// Runs the progressive passes with a progress bar, previews and checkpoints between passes, and

@@ -26,7 +26,7 @@ struct Named<'a> {
 /// stale temporaries beside them.
 pub fn check(args: &RenderArgs) -> Result<()> {
     // An EXR cannot hold one channel name twice: refused now, not after the render.
-    if let Some(twice) = args.aov.iter().enumerate().find(|(i, aov)| args.aov[..*i].contains(aov)).map(|(_, a)| a) {
+    if let Some(twice) = super::first_repeat(&args.aov) {
         return Err(Error::invalid(format!("--aov {} is given twice", twice.name())));
     }
     let mut outputs = vec![Named { flag: "-o", path: &args.output }];

@@ -17,7 +17,6 @@ Needs Ray: ``pip install 'lumiere[ray]'``. See docs/DISTRIBUTED.md for measureme
 from __future__ import annotations
 
 import math
-import operator
 import os
 import socket
 import time
@@ -27,7 +26,7 @@ import numpy as np
 
 from .. import _lumiere
 from .._render import Progress, RenderResult, _array, _camera, _options
-from .._scene import Camera, Scene
+from .._scene import Camera, Scene, _integer
 from ..errors import LumiereError
 
 __all__ = ["ClusterUnreachable", "connect", "render", "render_full", "split_passes"]
@@ -116,17 +115,6 @@ def _render_range(
     }
 
 
-def _integer(name: str, value: Any, least: int, why: str = "") -> int:
-    """``value`` as an int (numpy integers too, bools not) of at least ``least``, or the refusal."""
-    try:
-        number = None if isinstance(value, bool) else operator.index(value)
-    except TypeError:
-        number = None
-    if number is None or number < least:
-        raise LumiereError(f"{name} must be an integer of at least {least}, got {value!r}{why}")
-    return number
-
-
 def render_full(
     scene: Scene,
     camera: Optional[Camera] = None,
@@ -150,10 +138,12 @@ def render_full(
     pass, passes, worker wall and CPU seconds, host and pid; ``seconds``: the driver's wall time)."""
     if not isinstance(scene, Scene):
         raise TypeError(f"scene must be a lumiere.Scene, got {type(scene).__name__}")
-    spp = _integer("spp", spp, 1, " (a distributed render does a fixed number of passes)")
-    tasks = None if tasks is None else _integer("tasks", tasks, 1)
-    threads_per_task = _integer("threads_per_task", threads_per_task, 1)
-    max_retries = _integer("max_retries", max_retries, 0)
+    if spp is None:
+        raise LumiereError("spp must be given: a distributed render does a fixed number of passes")
+    spp = _integer(spp, "spp", 1)
+    tasks = None if tasks is None else _integer(tasks, "tasks", 1)
+    threads_per_task = _integer(threads_per_task, "threads_per_task", 1)
+    max_retries = _integer(max_retries, "max_retries", 0)
     if not (isinstance(checkpoint_every, (int, float)) and not isinstance(checkpoint_every, bool)
             and math.isfinite(checkpoint_every) and checkpoint_every >= 0):
         raise LumiereError(f"checkpoint_every must be a finite number of seconds, at least 0, got {checkpoint_every!r}")
@@ -161,7 +151,7 @@ def render_full(
     if checkpoint is not None:
         _lumiere.check_writable_output(os.fspath(checkpoint))
     # Refused here, before connecting, rather than by every worker's thread pool.
-    if threads_per_task is not None and threads_per_task > 1024:
+    if threads_per_task > 1024:
         raise LumiereError(f"threads_per_task must be at most 1024 (as --threads), got {threads_per_task}")
     option_args = dict(mode=str(mode), spp=spp, seed=seed, sampler=None if sampler is None else str(sampler), **technique_options)
     options = _options(mode, spp, seed, sampler, None, None, technique_options)

@@ -9,6 +9,7 @@ import sys
 from typing import List, Optional
 
 from .. import Camera, LumiereError, _lumiere, builtin, load, write_image
+from .._scene import _first_repeat
 from . import ClusterUnreachable, render_full
 
 #: ``lumiere render``'s exit code for bad input.
@@ -75,8 +76,7 @@ def run(args: argparse.Namespace) -> int:
     _lumiere.check_image_output(args.output, args.exposure, _tonemap(args.mode))
     if (args.eye is None) != (args.target is None):
         raise LumiereError("--eye and --target go together")
-    names = [name for name, _ in args.emission]
-    twice = next((name for i, name in enumerate(names) if name in names[:i]), None)
+    twice = _first_repeat([name for name, _ in args.emission])
     if twice is not None:
         raise LumiereError(f"--emission {twice!r} is given twice")
     emission = dict(args.emission)
