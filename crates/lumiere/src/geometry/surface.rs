@@ -37,14 +37,15 @@ impl SurfacePoint {
     }
 
     /// The segment from this point (offset to the side of `target`) to `target`, ending exactly at
-    /// `t = 1`: a shadow ray.
-    #[inline]
+    /// `t = 1`: a shadow ray. Always inlined, as the offsets below: called from a lane loop (the
+    /// path tracer's diffuse vertices) and left out of line, it kept the loop from vectorising.
+    #[inline(always)]
     pub fn spawn_segment(&self, target: Vec3) -> Ray {
         Ray::segment(self.offset_origin(target - self.p), target)
     }
 
     /// The origin for rays leaving towards `dir`: `p` moved off the surface on `dir`'s side.
-    #[inline]
+    #[inline(always)]
     pub fn offset_origin(&self, dir: Vec3) -> Vec3 {
         offset_origin(self.p, self.ng, dir)
     }
@@ -52,7 +53,7 @@ impl SurfacePoint {
 
 /// [`SurfacePoint::offset_origin`] of the point `p` with geometric normal `ng`, for callers that
 /// keep points in rows rather than as `SurfacePoint`s.
-#[inline]
+#[inline(always)]
 pub fn offset_origin(p: Vec3, ng: Vec3, dir: Vec3) -> Vec3 {
     let side = if ng.dot(dir) >= 0.0 { ng } else { -ng };
     offset_ray_origin(p, side)
