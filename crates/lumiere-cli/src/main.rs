@@ -15,7 +15,7 @@ fn main() -> ExitCode {
         // The reader of stdout went away (`lumiere info x.obj | head -1`): nothing left to say.
         Err(e) if output::is_closed_stdout(&e) => ExitCode::SUCCESS,
         Err(e) => {
-            let _ = writeln!(std::io::stderr().lock(), "lumiere: error: {e}");
+            let _ = writeln!(std::io::stderr().lock(), "lumiere: error: {}", lumiere::error::one_line(&e.to_string()));
             ExitCode::from(2)
         }
     }

@@ -29,6 +29,16 @@ pub fn invalid(message: impl Into<String>) -> PyErr {
     to_py(lumiere::Error::invalid(message))
 }
 
+/// An unsigned integer argument of at most `max`, or `LumiereError` naming `what`: PyO3's own
+/// refusal of a negative or huge number is a bare `OverflowError` that names no argument.
+pub fn unsigned(value: &Bound<'_, PyAny>, what: &str, max: u64) -> PyResult<u64> {
+    value
+        .extract::<u64>()
+        .ok()
+        .filter(|&v| v <= max)
+        .ok_or_else(|| invalid(format!("{what} must be an integer between 0 and {max}, got {value}")))
+}
+
 /// Converts a library result.
 pub trait OrPyErr<T> {
     fn or_py(self) -> PyResult<T>;

@@ -16,7 +16,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyByteArray;
 
 use crate::camera::PyCamera;
-use crate::errors::{OrPyErr, invalid};
+use crate::errors::{OrPyErr, invalid, unsigned};
 use crate::options::PyOptions;
 use crate::pixels::{from_bytes, to_bytearray};
 use crate::render::pool;
@@ -35,11 +35,14 @@ pub fn render_passes<'py>(
     scene: &PyScene,
     camera: &PyCamera,
     options: &PyOptions,
-    first: u32,
-    count: u32,
-    threads: usize,
+    first: &Bound<'py, PyAny>,
+    count: &Bound<'py, PyAny>,
+    threads: &Bound<'py, PyAny>,
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Vec<Pass<'py>>> {
+    let max = u64::from(u32::MAX);
+    let (first, count) = (unsigned(first, "first", max)? as u32, unsigned(count, "count", max)? as u32);
+    let threads = unsigned(threads, "threads", max)? as usize;
     let (world, camera, options) = (&*scene.world, &camera.camera, &options.options);
     let pool = pool(threads)?;
     let total = u64::from(camera.width) * u64::from(camera.height) * u64::from(count);
@@ -62,7 +65,9 @@ pub struct PyFilm {
 #[pymethods]
 impl PyFilm {
     #[new]
-    fn new(width: u32, height: u32) -> PyResult<Self> {
+    fn new(width: &Bound<'_, PyAny>, height: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let max = u64::from(u32::MAX);
+        let (width, height) = (unsigned(width, "width", max)? as u32, unsigned(height, "height", max)? as u32);
         Ok(PyFilm { film: Film::new(width, height).or_py()?, stats: RenderStats::default() })
     }
 

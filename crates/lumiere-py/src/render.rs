@@ -35,11 +35,7 @@ pub fn pool(threads: usize) -> PyResult<Arc<rayon::ThreadPool>> {
     {
         return Ok(pool.clone());
     }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| invalid(format!("cannot start {threads} threads: {e}")))?;
-    let pool = Arc::new(pool);
+    let pool = Arc::new(lumiere::util::threads::pool(threads).or_py()?);
     *last = Some((threads, pool.clone()));
     Ok(pool)
 }

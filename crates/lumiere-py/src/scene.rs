@@ -127,9 +127,11 @@ impl PyScene {
         self.world.scene().name.clone()
     }
 
+    /// The loader's warnings, then the world's (textures that could not be read or decoded):
+    /// everything the CLI prints before a render.
     #[getter]
     fn warnings(&self) -> Vec<String> {
-        self.world.scene().warnings.clone()
+        self.world.scene().warnings.iter().chain(self.world.warnings()).cloned().collect()
     }
 
     /// What `lumiere info` prints, as a dict.
@@ -178,7 +180,7 @@ impl PyScene {
             materials.set_item(&material.name, entry)?;
         }
         info.set_item("materials", materials)?;
-        info.set_item("warnings", scene.warnings.clone())?;
+        info.set_item("warnings", self.warnings())?;
         info.set_item("load_seconds", self.load_seconds)?;
         info.set_item("build_seconds", self.build_seconds)?;
         Ok(info)

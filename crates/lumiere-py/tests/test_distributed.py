@@ -113,6 +113,27 @@ def test_the_merged_checkpoint_resumes_in_the_cli(cluster, cli, tmp_path):
         distributed.render(scene, spp=8, seed=1, size=(32, 24), address=cluster.address, checkpoint=str(checkpoint), resume=True)
 
 
+def test_an_edited_scene_file_renders_again_and_a_stale_one_is_named(cluster, tmp_path):
+    obj = tmp_path / "box.obj"
+    obj.write_text("v -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 2 -1\nv 1 2 -1\nv 1 2 1\nf 1 3 2\nf 4 5 6\n")
+    camera = lumiere.Camera.look_at((0, 1, 4), (0, 1, 0), size=(16, 12))
+    options = dict(mode="hits", spp=2, address=cluster.address, tasks=4)
+    scene = lumiere.load(obj)
+    assert np.array_equal(bits(distributed.render(scene, camera, **options)), bits(lumiere.render(scene, camera, mode="hits", spp=2)))
+    # The workers rebuilt the first version; after an edit and a new load they must load it again.
+    obj.write_text(obj.read_text().replace("v 1 2 1", "v 0.5 2 1"))
+    edited = lumiere.load(obj)
+    assert edited.fingerprint != scene.fingerprint
+    local = lumiere.render(edited, camera, mode="hits", spp=2)
+    assert np.array_equal(bits(distributed.render(edited, camera, **options)), bits(local))
+    # Loaded, then edited before the render: the workers read a scene the driver does not have.
+    obj.write_text(obj.read_text().replace("v 0.5 2 1", "v 0.25 2 1"))
+    stale = lumiere.load(obj)
+    obj.write_text(obj.read_text().replace("v 0.25 2 1", "v 0.125 2 1"))
+    with pytest.raises(lumiere.LumiereError, match=f"{obj}: the worker on .* changed after lumiere.load read it here"):
+        distributed.render(stale, camera, **options)
+
+
 def test_the_command_line_writes_the_cli_bytes(cluster, cli, tmp_path):
     args = ["--size", "40x30", "--spp", "4", "--mode", "ao", "--samples", "2"]
     cli("render", *args, "-o", tmp_path / "cli.pfm")

@@ -136,6 +136,20 @@ def test_texture_placement_shows_in_info(tmp_path):
     assert plain["texture_placement"] is None and plain["cutout_placement"] is None
 
 
+def test_texture_warnings_reach_python_as_the_cli_prints_them(cli, tmp_path):
+    obj = tmp_path / "j2.obj"
+    obj.write_text("mtllib j2.mtl\nv -1 0 -1\nv 1 0 -1\nv 1 0 1\nvt 0 0\nusemtl m\nf 1/1 2/1 3/1\n")
+    (tmp_path / "j2.mtl").write_text("newmtl m\nKd 1 1 1\nmap_Kd missing.png\n")
+    with pytest.warns(UserWarning, match="missing.png") as caught:
+        scene = lumiere.load(obj)
+    missing = tmp_path / "missing.png"
+    expected = f'texture "{missing}": No such file or directory (os error 2); the material\'s Kd is used instead'
+    assert scene.warnings == [expected] and scene.info()["warnings"] == [expected]
+    assert [str(w.message) for w in caught] == [expected]
+    printed = cli("render", obj, "--mode", "materials", "--size", "8x6", "-o", tmp_path / "x.pfm").stderr
+    assert f"lumiere: warning: {expected}" in printed.splitlines()
+
+
 def test_cutouts_show_in_info_and_render_the_cli_bytes(cli, tmp_path):
     grey_png(tmp_path / "mask.png", [0, 255])
     obj = tmp_path / "leaf.obj"

@@ -74,6 +74,13 @@ pub fn shown_name(name: &str) -> String {
     if name.chars().any(char::is_control) { format!("{name:?}") } else { format!("'{name}'") }
 }
 
+/// `text` on one line: its lines trimmed and joined with spaces. For messages that quote another
+/// library's (an image decoder's ends with a newline), so that every error and warning stays one
+/// line.
+pub fn one_line(text: &str) -> String {
+    text.split(['\n', '\r']).map(str::trim).filter(|line| !line.is_empty()).collect::<Vec<_>>().join(" ")
+}
+
 impl std::error::Error for Error {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {

@@ -5,6 +5,7 @@ use glam::Vec3;
 use lumiere::accel::Isa;
 use lumiere::image_io::PngStyle;
 use lumiere::render::aov::Aov;
+use lumiere::util::threads::MAX_THREADS;
 
 #[derive(Parser, Debug)]
 #[command(name = "lumiere", version, about = "A CPU Monte Carlo ray tracer", propagate_version = true)]
@@ -391,10 +392,6 @@ fn parse_fov(s: &str) -> Result<f32, String> {
         Err(format!("the field of view must be between 0 and 180 degrees (exclusive), got {s:?}"))
     }
 }
-
-/// More threads than this would only cost memory and start-up time (and can exhaust the system's
-/// thread limit, which aborts instead of failing cleanly).
-const MAX_THREADS: usize = 1024;
 
 fn parse_threads(s: &str) -> Result<usize, String> {
     let value: usize = s.trim().parse().map_err(|_| format!("expected a thread count, got {s:?}"))?;

@@ -10,13 +10,14 @@ mod isa;
 pub mod output;
 mod render;
 
-use lumiere::{Error, Result};
+use lumiere::Result;
 
 pub use args::Cli;
 use args::Command;
 
 /// Runs a subcommand; returns the process exit code on success.
 pub fn run(cli: Cli) -> Result<u8> {
+    lumiere::util::threads::start_global_pool()?;
     match cli.command {
         Command::Render(args) => render::run(&args),
         Command::Info(args) => info::run(&args).map(|()| 0),
@@ -26,10 +27,7 @@ pub fn run(cli: Cli) -> Result<u8> {
     }
 }
 
-/// A rayon pool of `threads` workers (0: one per core).
+/// A rayon pool of `threads` workers (0: see [`lumiere::util::threads`]).
 fn pool(threads: usize) -> Result<rayon::ThreadPool> {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| Error::invalid(format!("cannot start {threads} threads: {e}")))
+    lumiere::util::threads::pool(threads)
 }

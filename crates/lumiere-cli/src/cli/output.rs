@@ -29,7 +29,7 @@ pub fn note(line: impl Display) {
 
 /// A one-line warning on stderr, if stderr can take it.
 pub fn warn(line: impl Display) {
-    let _ = writeln!(std::io::stderr().lock(), "lumiere: warning: {line}");
+    let _ = writeln!(std::io::stderr().lock(), "lumiere: warning: {}", lumiere::error::one_line(&line.to_string()));
 }
 
 /// True when `error` says stdout's reader has gone (a closed pipe): the command stops quietly.

@@ -61,6 +61,43 @@ fn denoise_without_oidn_fails_before_rendering() {
     assert!(start.elapsed() < Duration::from_secs(20), "took {:?}", start.elapsed());
 }
 
+/// A `pyoidn.py` in the folder the user renders from (a downloaded scene's, say) is never
+/// imported by the library lookup, and a `python3` that never answers does not stall the render.
+#[cfg(unix)]
+#[test]
+fn the_pyoidn_lookup_runs_nothing_from_the_working_folder_and_gives_up() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = TempDir::new("denoise-lookup");
+    let marker = dir.path("ran");
+    fs::write(dir.path("pyoidn.py"), format!("open({:?}, 'w').write('ran')\n", marker.to_str().unwrap())).unwrap();
+    let lookup = |path: &std::ffi::OsStr| {
+        lumiere()
+            .args(["render", "--denoise", "--size", "8x6", "-o", "out.png"])
+            .current_dir(dir.path(""))
+            .env("OIDN_DIR", dir.path("no-such-folder"))
+            .env_remove("LUMIERE_NO_PYOIDN")
+            .env("PATH", path)
+            .output()
+            .unwrap()
+    };
+    // The system's python3 (where there is one): the scene folder's module must not run.
+    let out = lookup(&std::env::var_os("PATH").unwrap_or_default());
+    assert!(!marker.exists(), "the working folder's pyoidn.py ran: {}", stderr(&out));
+
+    // A python3 that hangs: the lookup gives up, the render goes on (here to the missing library).
+    let bin = dir.path("bin");
+    fs::create_dir(&bin).unwrap();
+    let python = bin.join("python3");
+    fs::write(&python, "#!/bin/sh\nexec /bin/sleep 60\n").unwrap();
+    fs::set_permissions(&python, fs::Permissions::from_mode(0o755)).unwrap();
+    let start = Instant::now();
+    let out = lookup(bin.as_os_str());
+    let text = stderr(&out);
+    assert!(start.elapsed() < Duration::from_secs(30), "took {:?}: {text}", start.elapsed());
+    assert_eq!(out.status.code(), Some(2), "{text}");
+    assert!(text.contains("was not found"), "{text}");
+}
+
 #[test]
 fn denoising_four_samples_comes_closer_to_the_converged_image() {
     let dir = TempDir::new("denoise-rmse");

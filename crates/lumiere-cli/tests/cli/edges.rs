@@ -242,6 +242,23 @@ fn outputs_that_are_textures_or_masks_are_refused() {
     }
 }
 
+/// `--threads 0` (the default) follows `RAYON_NUM_THREADS`, as rayon does, but never past the cap
+/// that `--threads` has: 100,000 threads would take minutes to start, or exhaust the system's limit.
+#[test]
+fn the_environments_thread_count_is_capped_as_the_flags() {
+    let dir = TempDir::new("threads-environment");
+    let out = lumiere()
+        .args(["render", "--size", "16x12", "--mode", "hits", "--stats-json", "-", "-o", &dir.arg("o.png")])
+        .env("RAYON_NUM_THREADS", "100000")
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    let stats = String::from_utf8_lossy(&out.stdout);
+    assert!(stats.contains("\"threads\": 1024"), "{stats}");
+    let out = lumiere().args(["info"]).env("RAYON_NUM_THREADS", "100000").output().unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+}
+
 #[test]
 fn stats_go_to_stdout_with_a_dash() {
     let dir = TempDir::new("stats-stdout");

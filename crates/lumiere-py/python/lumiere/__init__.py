@@ -42,15 +42,14 @@ __all__ = [
 def write_image(path: str, image: "object", exposure: float = 0.0, tonemap: str = "aces") -> None:
     """Writes a ``(height, width, 3)`` float image as ``lumiere render -o`` does: ``.png``
     (exposure, ``aces`` or ``clamp`` tone mapping, sRGB), ``.exr`` or ``.pfm`` (linear), atomically."""
-    import os
-
     import numpy as np
 
     array = np.ascontiguousarray(image, dtype=np.float32)
     if array.ndim != 3 or array.shape[2] != 3:
         raise LumiereError(f"image must have shape (height, width, 3), got {array.shape}")
     height, width = array.shape[:2]
-    _write_image(os.fsdecode(os.fspath(path)), width, height, array.tobytes(), exposure, tonemap)
+    _write_image(_path(path), width, height, array.tobytes(), _number(exposure, "exposure"), _text(tonemap, "tonemap"))
 
 
 from ._lumiere import write_image as _write_image  # noqa: E402
+from ._scene import _number, _path, _text  # noqa: E402

@@ -112,3 +112,11 @@ def render_passes(
 def write_image(
     path: _Path, width: int, height: int, pixels: bytes, exposure: float = 0.0, tonemap: str = "aces"
 ) -> None: ...
+
+def read_input(path: _Path) -> bytes:
+    """The bytes of a regular file (FIFOs and devices refused unread), as scenes are read."""
+
+def check_outputs(
+    outputs: Sequence[Tuple[str, _Path]], inputs: Sequence[Tuple[str, _Path]], scene: Optional[NativeScene] = None
+) -> None:
+    """Refuses (name, path) outputs that are one file, an input, or a file ``scene`` read."""

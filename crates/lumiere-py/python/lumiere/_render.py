@@ -9,7 +9,7 @@ from typing import Any, Callable, Dict, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from . import _lumiere
-from ._scene import DEFAULT_SIZE, Camera, Scene, _first_repeat, _integer, _number
+from ._scene import DEFAULT_SIZE, Camera, Scene, _first_repeat, _integer, _number, _text
 from .errors import LumiereError
 
 __all__ = ["render", "render_full", "RenderResult", "MODES", "AOVS", "TECHNIQUE_OPTIONS"]
@@ -62,12 +62,17 @@ def _options(
     seed = _integer(seed, "seed", 0, 2**64 - 1)
     # 2**32 - 1 is the native side's "until a budget stops it", which spp=None asks for.
     spp = None if spp is None else _integer(spp, "spp", 1, 2**32 - 2)
+    # Checked in place: lumiere.distributed ships the checked values to its workers.
     for name, low in (("samples", 1), ("max_depth", 0)):
         if technique_options.get(name) is not None:
             technique_options[name] = _integer(technique_options[name], name, low, 2**32 - 1)
-    options = _lumiere.NativeOptions(
-        str(mode), spp, seed, None if sampler is None else str(sampler), time=time, noise=noise, **technique_options
-    )
+    if technique_options.get("ao_distance") is not None:
+        technique_options["ao_distance"] = _number(technique_options["ao_distance"], "ao_distance")
+    if technique_options.get("light_sampling") is not None:
+        technique_options["light_sampling"] = _text(technique_options["light_sampling"], "light_sampling")
+    mode = _text(mode, "mode")
+    sampler = None if sampler is None else _text(sampler, "sampler")
+    options = _lumiere.NativeOptions(mode, spp, seed, sampler, time=time, noise=noise, **technique_options)
     for message in options.ignored:
         warnings.warn(message, stacklevel=3)
     return options
@@ -112,7 +117,7 @@ def render_full(
     camera = _camera(scene, camera, size)
     if isinstance(aovs, str):
         aovs = (aovs,)
-    aovs = tuple(aovs)
+    aovs = tuple(_text(aov, f"aovs[{index}]") for index, aov in enumerate(aovs))
     # An EXR cannot hold a channel twice, and the CLI refuses it: so does this.
     twice = _first_repeat(aovs)
     if twice is not None:

@@ -5,14 +5,16 @@ from __future__ import annotations
 
 import math
 import os
+import sys
 import uuid
+import warnings
 from collections import OrderedDict
 from typing import Any, Dict, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
 from . import _lumiere
-from .errors import LumiereError, LumiereOSError
+from .errors import LumiereError
 
 __all__ = ["Scene", "Camera", "load", "builtin", "DEFAULT_SIZE"]
 
@@ -31,7 +33,7 @@ def _emission_list(emission: Optional[Mapping[str, Vector]]) -> list:
         return []
     if not isinstance(emission, Mapping):
         raise LumiereError("emission must be a dict {material name: (r, g, b)}")
-    return [(str(name), _vector(value, f"emission[{name!r}]")) for name, value in emission.items()]
+    return [(_text(name, "emission name"), _vector(value, f"emission[{name!r}]")) for name, value in emission.items()]
 
 
 def _vector(value: Any, what: str) -> Tuple[float, float, float]:
@@ -42,6 +44,9 @@ def _vector(value: Any, what: str) -> Tuple[float, float, float]:
         x, y, z = (float(v) for v in value)
     except (TypeError, ValueError):
         raise LumiereError(f"{what} must be three numbers, got {value!r}") from None
+    except OverflowError:
+        # An integer beyond float64's range: beyond float32's too (its digits are not worth printing).
+        raise LumiereError(f"{what} must fit in float32 (at most {_F32_MAX:.7g} in magnitude)") from None
     # The native side stores float32: a finite number beyond its range would arrive as infinity
     # and be refused under another name (infinity and NaN are left to its own checks).
     if any(math.isfinite(v) and abs(v) > _F32_MAX for v in (x, y, z)):
@@ -57,6 +62,21 @@ def _number(value: Any, what: str) -> float:
         return float(value)
     except (TypeError, ValueError):
         raise LumiereError(f"{what} must be a number, got {value!r}") from None
+    except OverflowError:
+        # An integer beyond float64's range (its digits are not worth printing).
+        raise LumiereError(f"{what} must be at most {sys.float_info.max:.7g} in magnitude") from None
+
+
+def _text(value: Any, what: str) -> str:
+    """``value`` if it is a ``str`` the native side can take (UTF-8: no lone surrogates, which
+    ``os.fsdecode`` makes of undecodable bytes)."""
+    if not isinstance(value, str):
+        raise LumiereError(f"{what} must be a string, got {value!r}")
+    try:
+        value.encode("utf-8")
+    except UnicodeEncodeError:
+        raise LumiereError(f"{what} must be valid Unicode text, got {value!r}") from None
+    return value
 
 
 def _path(path: Any) -> str:
@@ -82,6 +102,18 @@ def _integer(value: Any, what: str, low: int, high: Optional[int] = None) -> int
 def _first_repeat(items: Sequence[Any]) -> Optional[Any]:
     """The first item given a second time, or None: an option named twice, which the CLI refuses."""
     return next((item for i, item in enumerate(items) if item in items[:i]), None)
+
+
+def _own_array(value: Any, dtype: Any, what: str) -> np.ndarray:
+    """A C-contiguous copy of ``value`` as ``dtype``, read-only: a scene's recipe must not share
+    the caller's buffer, which the caller may change after the scene is made (numpy's
+    ``ascontiguousarray`` returns the very array when it already fits)."""
+    try:
+        array = np.array(value, dtype=dtype, order="C", copy=True)
+    except (TypeError, ValueError, OverflowError):
+        raise LumiereError(f"{what} must be an array of numbers") from None
+    array.flags.writeable = False
+    return array
 
 
 def _size(size: Any) -> Tuple[int, int]:
@@ -128,8 +160,12 @@ class Scene:
             grey material.
         :param material_ids: the material of each triangle, shape ``(M,)``; default all 0.
         :param normals: optional per-vertex shading normals, shape ``(N, 3)``.
+
+        The arrays are copied: changing them afterwards changes neither the scene nor its pickles
+        (which rebuild it from the copies).
         """
-        vertices = np.ascontiguousarray(vertices, dtype=np.float32)
+        name = _text(name, "name")
+        vertices = _own_array(vertices, np.float32, "vertices")
         if vertices.ndim != 2 or vertices.shape[1] != 3:
             raise LumiereError(f"vertices must have shape (N, 3), got {vertices.shape}")
         triangles = np.asarray(triangles)
@@ -137,7 +173,7 @@ class Scene:
             raise LumiereError(f"triangles must be integers of shape (M, 3), got {triangles.dtype} {triangles.shape}")
         if triangles.size and (triangles.min() < 0 or triangles.max() >= len(vertices)):
             raise LumiereError(f"triangles index vertices 0..{len(vertices) - 1}, found {triangles.min()}..{triangles.max()}")
-        triangles = np.ascontiguousarray(triangles, dtype=np.uint32)
+        triangles = _own_array(triangles, np.uint32, "triangles")
         if isinstance(materials, (str, bytes)):
             raise LumiereError(f"materials must be a list of names or dicts, got {materials!r}")
         specs = []
@@ -151,7 +187,7 @@ class Scene:
                 raise LumiereError(f"materials[{index}]: unknown keys {sorted(unknown)} (known: name, kd, ke)")
             kd = _vector(material.get("kd", (0.8, 0.8, 0.8)), f"materials[{index}]['kd']")
             ke = _vector(material.get("ke", (0.0, 0.0, 0.0)), f"materials[{index}]['ke']")
-            specs.append((str(material["name"]), kd, ke))
+            specs.append((_text(material["name"], f"materials[{index}]['name']"), kd, ke))
         if material_ids is None:
             ids = np.zeros(len(triangles), dtype=np.uint32)
         else:
@@ -160,9 +196,9 @@ class Scene:
                 raise LumiereError(f"material_ids must be {len(triangles)} integers, got {ids.dtype} {ids.shape}")
             if ids.size and (ids.min() < 0 or ids.max() >= len(specs)):
                 raise LumiereError(f"material_ids index materials 0..{len(specs) - 1}, found {ids.min()}..{ids.max()}")
-            ids = np.ascontiguousarray(ids, dtype=np.uint32)
+            ids = _own_array(ids, np.uint32, "material_ids")
         if normals is not None:
-            normals = np.ascontiguousarray(normals, dtype=np.float32)
+            normals = _own_array(normals, np.float32, "normals")
             if normals.shape != vertices.shape:
                 raise LumiereError(f"normals must have the shape of vertices {vertices.shape}, got {normals.shape}")
         native = _lumiere.NativeScene.from_arrays(
@@ -174,7 +210,7 @@ class Scene:
             None if normals is None else normals.tobytes(),
         )
         recipe = ("arrays", vertices, triangles, specs, ids, normals, name, uuid.uuid4().hex)
-        return cls(native, recipe)
+        return _made(native, recipe)
 
     def info(self) -> Dict[str, Any]:
         """What ``lumiere info`` prints: ``name``, ``triangles``, ``vertices``, ``materials`` (by
@@ -189,7 +225,9 @@ class Scene:
 
     @property
     def warnings(self) -> list:
-        """Non-fatal problems met while loading (a missing MTL file, an unknown material)."""
+        """Non-fatal problems met while loading (a missing MTL file, an unknown material) and
+        building (a texture that cannot be read or decoded), as ``lumiere render`` prints them;
+        each was also issued as a Python warning when the scene was made."""
         return self._native.warnings
 
     @property
@@ -200,6 +238,11 @@ class Scene:
     @property
     def is_builtin(self) -> bool:
         return self._native.builtin
+
+    @property
+    def _file(self) -> Optional[str]:
+        """The file the scene was loaded from; None for the built-in scene and arrays."""
+        return self._recipe[1] if self._recipe[0] == "load" else None
 
     def __reduce__(self) -> tuple:
         return (_rebuild_scene, (self._recipe,))
@@ -214,20 +257,33 @@ _SCENES: "OrderedDict[tuple, _lumiere.NativeScene]" = OrderedDict()
 _SCENES_KEPT = 4
 
 
+def _made(native: "_lumiere.NativeScene", how: tuple) -> Scene:
+    """A scene made in this process from ``how`` (a recipe less the fingerprint), its warnings
+    issued as the CLI prints them. The recipe records the fingerprint, so that a process
+    rebuilding it can tell a scene it cached from an older version of the file (see
+    :func:`_rebuild_scene`)."""
+    for message in native.warnings:
+        # stacklevel: the caller of load(), builtin() or Scene.from_arrays().
+        warnings.warn(message, stacklevel=3)
+    return Scene(native, (*how, native.fingerprint))
+
+
 def _rebuild_scene(recipe: tuple) -> Scene:
-    kind = recipe[0]
+    kind, fingerprint = recipe[0], recipe[-1]
     if kind == "load":
         key: tuple = (kind, recipe[1], tuple(recipe[2]))
     elif kind == "arrays":
-        key = (kind, recipe[-1])
+        key = (kind, recipe[-2])
     else:
         raise LumiereError(f"unknown scene recipe {kind!r}")
     native = _SCENES.get(key)
-    if native is None:
+    # A scene cached from the file before it was edited is loaded again (its fingerprint is not
+    # the one the maker of the recipe saw); a mismatch left after that is for the driver to report.
+    if native is None or native.fingerprint != fingerprint:
         if kind == "load":
             native = _lumiere.NativeScene.load(recipe[1], list(recipe[2]))
         else:
-            _, vertices, triangles, specs, ids, normals, name, _ = recipe
+            _, vertices, triangles, specs, ids, normals, name, _, _ = recipe
             native = _lumiere.NativeScene.from_arrays(
                 name, vertices.tobytes(), triangles.tobytes(), ids.tobytes(), specs, None if normals is None else normals.tobytes()
             )
@@ -248,14 +304,14 @@ def load(path: PathLike, emission: Optional[Mapping[str, Vector]] = None) -> Sce
     """
     path = os.path.abspath(_path(path))
     emission = _emission_list(emission)
-    return Scene(_lumiere.NativeScene.load(path, emission), ("load", path, emission))
+    return _made(_lumiere.NativeScene.load(path, emission), ("load", path, emission))
 
 
 def builtin(emission: Optional[Mapping[str, Vector]] = None) -> Scene:
     """gKit's Cornell box, embedded in lumiere (what ``lumiere render`` renders without a scene).
     With ``camera=None``, :func:`lumiere.render` uses its orbiter camera."""
     emission = _emission_list(emission)
-    return Scene(_lumiere.NativeScene.load(None, emission), ("load", None, emission))
+    return _made(_lumiere.NativeScene.load(None, emission), ("load", None, emission))
 
 
 class Camera:
@@ -288,14 +344,9 @@ class Camera:
     def orbiter(cls, path: PathLike, size: Tuple[int, int] = DEFAULT_SIZE) -> "Camera":
         """gKit's orbiter camera from an orbiter file (``--orbiter``)."""
         path = _path(path)
-        try:
-            with open(path, "rb") as file:
-                text = file.read()
-        except OSError as e:
-            error = LumiereOSError(f"{path}: {e.strerror} (os error {e.errno})")
-            error.errno, error.filename = e.errno, path
-            raise error from None
-        args = (text, path, *_size(size))
+        # As lumiere.load and --orbiter read files: a regular file only (a FIFO would block, a
+        # device such as /dev/zero never end), never past its size.
+        args = (_lumiere.read_input(path), path, *_size(size))
         return cls(_lumiere.NativeCamera.orbiter(*args), ("orbiter", args))
 
     @classmethod
@@ -323,6 +374,12 @@ class Camera:
     @property
     def width(self) -> int:
         return self._native.width
+
+    @property
+    def _file(self) -> Optional[str]:
+        """The orbiter file the camera was read from; None for other cameras."""
+        kind, args = self._recipe
+        return args[1] if kind == "orbiter" else None
 
     @property
     def height(self) -> int:

@@ -6,7 +6,7 @@ pub mod camera;
 pub mod load;
 pub mod mesh;
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 
@@ -33,6 +33,14 @@ impl Scene {
     /// Loads a scene file, choosing the loader by its extension (see [`load::load`]).
     pub fn load(path: &Path) -> Result<Scene> {
         load::load(path)
+    }
+
+    /// The files read besides the scene file itself: the material libraries, then every texture
+    /// the materials name (`map_Kd`, `map_d`), whether or not it could be decoded. No output may
+    /// overwrite one (`util::overwrite::check_scene_files`).
+    pub fn files_read(&self) -> impl Iterator<Item = &Path> {
+        let textures = self.materials.iter().flat_map(|m| [m.map_kd.as_deref(), m.map_d.as_deref()]).flatten();
+        self.sources.iter().map(PathBuf::as_path).chain(textures)
     }
 
     /// gKit's Cornell box, embedded in the binary.

@@ -514,7 +514,7 @@ const WITHOUT_COVERAGE: &str = "the material stays opaque";
 /// The warning about texture file `path`: quoted and escaped like a string literal (not cut: the
 /// user must find the file), so that a control character from the MTL file cannot garble the line.
 fn unusable(path: &Path, reason: &str, instead: &str) -> String {
-    format!("texture {:?}: {reason}; {instead}", path.to_string_lossy())
+    format!("texture {:?}: {}; {instead}", path.to_string_lossy(), crate::error::one_line(reason))
 }
 
 /// The checks on a texture file that its metadata answers: it is there, a regular file, and not

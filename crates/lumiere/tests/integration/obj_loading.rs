@@ -77,6 +77,25 @@ fn crlf_tabs_trailing_spaces_and_no_final_newline() {
     assert_eq!(scene.mesh.positions[1], Vec3::X);
 }
 
+/// Classic Mac OS line ends (a lone `\r`) are refused at line 1, whatever the first line holds
+/// (a comment made the whole file one comment, an empty scene); in an MTL file they cost one
+/// warning and its materials, not one warning per statement read as a file name.
+#[test]
+fn lone_carriage_returns_are_refused_by_name() {
+    let refused = "lone carriage-return line ends (classic Mac OS) are not supported";
+    assert_error(b"# exported\rv -1 0 -1\rv 1 0 -1\rv 1 0 1\rf 1 2 3\r", 1, refused);
+    assert_error(b"mtllib base.mtl\rv 0 0 0\rv 1 0 0\rv 0 1 0\rf 1 2 3\r", 1, refused);
+    // A CRLF file, with a blank CRLF line doubled, still loads.
+    assert_eq!(parse("v 0 0 0\r\r\nv 1 0 0\r\nv 0 1 0\r\nf 1 2 3\r\n").mesh.triangle_count(), 1);
+    let scene = parse_with(
+        "mtllib mac.mtl\nusemtl red\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+        &[("mac.mtl", "newmtl red\rKd 1 0 0\r")],
+    );
+    let carriage: Vec<_> = scene.warnings.iter().filter(|w| w.contains(refused)).collect();
+    assert_eq!(carriage.len(), 1, "{:#?}", scene.warnings);
+    assert!(carriage[0].contains("mac.mtl:1:"), "{}", carriage[0]);
+}
+
 #[test]
 fn polygons_split_as_fans_in_file_order() {
     let text = format!("{SQUARE}v 2 2 0\nf 1 2 3 4\nf 5 4 3 2 1\n");

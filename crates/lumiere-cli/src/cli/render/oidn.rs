@@ -2,12 +2,16 @@
 //! link-time dependency on it, so it builds and runs everywhere, and only `--denoise` needs it.
 //!
 //! The library is looked for, in order, in `$OIDN_DIR/lib`, `$OIDN_DIR`, the `pyoidn` Python
-//! package that `python3` imports (its `oidn/lib/`; `LUMIERE_NO_PYOIDN=1` skips this step), and
-//! the system's library path.
+//! package that `python3` imports (its `oidn/lib/`; `LUMIERE_NO_PYOIDN=1` skips this step; the
+//! lookup never imports from the working folder, and gives up after ten seconds), and the
+//! system's library path.
 
 use std::ffi::{CStr, CString, c_char, c_void};
+use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
 
 use glam::Vec3;
 use lumiere::{Error, Result};
@@ -237,15 +241,49 @@ fn candidates() -> Vec<PathBuf> {
     candidates
 }
 
+/// How long `python3` may take to say where pyoidn is: importing it takes well under a second,
+/// and a `python3` that never answers must not stall the render.
+const PYOIDN_LOOKUP_TIMEOUT: Duration = Duration::from_secs(10);
+
 /// The folder of the `pyoidn` package that `python3` imports, if any.
+///
+/// `python3 -c` puts its working folder first on the import path, and the user's is often a
+/// downloaded scene's: a `pyoidn.py` there would run, and the library it names be loaded. So the
+/// lookup runs from the root folder, which only an administrator can write to, with
+/// `PYTHONSAFEPATH` set as well (Python 3.11 and later then add no folder at all), and is given up
+/// after [`PYOIDN_LOOKUP_TIMEOUT`].
 fn pyoidn_dir() -> Option<PathBuf> {
-    let output = Command::new("python3")
+    let mut child = Command::new("python3")
         .args(["-c", "import pyoidn, os; print(os.path.dirname(pyoidn.__file__))"])
+        .current_dir("/")
+        .env("PYTHONSAFEPATH", "1")
         .stdin(Stdio::null())
+        .stdout(Stdio::piped())
         .stderr(Stdio::null())
-        .output()
+        .spawn()
         .ok()?;
-    let dir = String::from_utf8(output.stdout).ok()?;
+    // Read on a thread, so that a child which never closes its output cannot hold the render.
+    let mut stdout = child.stdout.take()?;
+    let (sender, receiver) = mpsc::channel();
+    std::thread::spawn(move || {
+        let mut text = Vec::new();
+        let _ = stdout.read_to_end(&mut text);
+        let _ = sender.send(text);
+    });
+    let deadline = Instant::now() + PYOIDN_LOOKUP_TIMEOUT;
+    let status = loop {
+        match child.try_wait() {
+            Ok(Some(status)) => break status,
+            Ok(None) if Instant::now() < deadline => std::thread::sleep(Duration::from_millis(5)),
+            _ => {
+                let _ = child.kill();
+                let _ = child.wait();
+                return None;
+            }
+        }
+    };
+    let text = receiver.recv_timeout(deadline.saturating_duration_since(Instant::now())).ok()?;
+    let dir = String::from_utf8(text).ok()?;
     let dir = dir.trim();
-    (output.status.success() && !dir.is_empty()).then(|| PathBuf::from(dir))
+    (status.success() && !dir.is_empty()).then(|| PathBuf::from(dir))
 }

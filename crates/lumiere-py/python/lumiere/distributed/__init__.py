@@ -26,7 +26,7 @@ import numpy as np
 
 from .. import _lumiere
 from .._render import Progress, RenderResult, _array, _camera, _options
-from .._scene import Camera, Scene, _integer
+from .._scene import Camera, Scene, _integer, _path
 from ..errors import LumiereError
 
 __all__ = ["ClusterUnreachable", "connect", "render", "render_full", "split_passes"]
@@ -115,6 +115,26 @@ def _render_range(
     }
 
 
+def _check_outputs(outputs: Sequence[Tuple[str, str]], scene: Scene, scene_name: str, camera: Camera, camera_name: str) -> None:
+    """Refuses ``outputs`` ((name, path) pairs) that are one file, or that would overwrite a file
+    the render reads: the scene file, its material libraries and textures, the orbiter file. These
+    are ``lumiere render``'s checks and messages, the files named as the caller names them (the
+    Python argument, or the flag)."""
+    inputs = [(name, file) for name, file in ((scene_name, scene._file), (camera_name, camera._file)) if file is not None]
+    _lumiere.check_outputs(list(outputs), inputs, scene._native)
+
+
+def _different_scene(scene: Scene, host: str) -> str:
+    """Why a worker's scene differs from the driver's, as far as the driver can tell."""
+    if scene._file is not None:
+        return (
+            f"{scene._file}: the worker on {host} read a different scene from this file: it differs on that "
+            "node, or it changed after lumiere.load read it here (load it again)"
+        )
+    made = "the built-in scene" if scene.is_builtin else "the same arrays"
+    return f"{scene.name}: the worker on {host} built a different scene from {made} (is the same lumiere version installed on every node?)"
+
+
 def render_full(
     scene: Scene,
     camera: Optional[Camera] = None,
@@ -149,13 +169,17 @@ def render_full(
         raise LumiereError(f"checkpoint_every must be a finite number of seconds, at least 0, got {checkpoint_every!r}")
     # Refused now, not once the render is done and the checkpoint cannot hold it.
     if checkpoint is not None:
-        _lumiere.check_writable_output(os.fspath(checkpoint))
+        checkpoint = _path(checkpoint)
+        _lumiere.check_writable_output(checkpoint)
     # Refused here, before connecting, rather than by every worker's thread pool.
     if threads_per_task > 1024:
         raise LumiereError(f"threads_per_task must be at most 1024 (as --threads), got {threads_per_task}")
-    option_args = dict(mode=str(mode), spp=spp, seed=seed, sampler=None if sampler is None else str(sampler), **technique_options)
     options = _options(mode, spp, seed, sampler, None, None, technique_options)
+    # What each worker builds its options from: the values `_options` accepted.
+    option_args = dict(mode=mode, spp=spp, seed=seed, sampler=sampler, **technique_options)
     camera = _camera(scene, camera, size)
+    if checkpoint is not None:
+        _check_outputs([("checkpoint", checkpoint)], scene, "scene", camera, "camera")
     width, height = camera.size
     if resume and checkpoint is not None and os.path.exists(checkpoint):
         film = _lumiere.NativeFilm.load_checkpoint(checkpoint, scene._native, camera._native, options)
@@ -182,10 +206,7 @@ def render_full(
                 pending.pop(ref)
                 result = ray.get(ref)
                 if result["fingerprint"] != scene.fingerprint:
-                    raise LumiereError(
-                        f"{scene.name}: the worker on {result['host']} loaded a different scene "
-                        "(is the same file at the same path on every node?)"
-                    )
+                    raise LumiereError(_different_scene(scene, result["host"]))
                 done[result["first"]] = result
                 records.append(
                     {k: result[k] for k in ("first", "seconds", "cpu_seconds", "host", "pid")} | {"passes": len(result["passes"])}

@@ -10,7 +10,7 @@ from typing import List, Optional
 
 from .. import Camera, LumiereError, _lumiere, builtin, load, write_image
 from .._scene import _first_repeat
-from . import ClusterUnreachable, render_full
+from . import ClusterUnreachable, _check_outputs, render_full
 
 #: ``lumiere render``'s exit code for bad input.
 EXIT_ERROR = 2
@@ -89,6 +89,10 @@ def run(args: argparse.Namespace) -> int:
         camera = Camera.builtin(args.size)
     else:
         camera = Camera.framing(scene, args.size, args.fov, args.up)
+    # As `lumiere render`: no output may replace another or a file the render reads (the scene,
+    # its MTL and textures, the orbiter), refused before any work.
+    outputs = [("-o", args.output)] + ([("--checkpoint", args.checkpoint)] if args.checkpoint else [])
+    _check_outputs(outputs, scene, "the scene", camera, "--orbiter")
     spp = args.spp if args.spp is not None else (8 if args.mode == "path" else 1)
     technique = {
         key: value

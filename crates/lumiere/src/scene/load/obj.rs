@@ -7,7 +7,8 @@
 //! indices and reports errors exactly as a sequential parser would (see `obj/chunk.rs`).
 //!
 //! Not supported: line continuations (a trailing `\`), free-form geometry, polylines and points
-//! (each skipped keyword is warned about once, with its count), and lone `\r` line ends.
+//! (each skipped keyword is warned about once, with its count), and lone `\r` line ends (refused
+//! with an error, as an MTL file with them is warned about and not read).
 
 mod chunk;
 mod materials;
@@ -156,6 +157,9 @@ fn parse_obj_within(
 ) -> Result<ObjScene> {
     // Editors on Windows may start the file with a UTF-8 byte-order mark.
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    if text::has_lone_carriage_returns(bytes) {
+        return Err(Error::parse(name, 1, text::LONE_CARRIAGE_RETURNS));
+    }
     let chunks = split_lines(bytes, chunk_bytes.max(1));
     let counts: Vec<ChunkCounts> = chunks.par_iter().map(|chunk| ChunkCounts::of(chunk)).collect();
     let (starts, totals) = chunk_starts(&counts);

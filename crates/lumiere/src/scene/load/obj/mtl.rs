@@ -1,7 +1,7 @@
 //! MTL (material library) parsing. Lenient by design: a bad line costs a warning, not the scene,
 //! because a render with one wrong material is more useful than no render.
 
-use super::text::{Tokens, finite_f32, lines, quoted};
+use super::text::{LONE_CARRIAGE_RETURNS, Tokens, finite_f32, has_lone_carriage_returns, lines, quoted};
 use crate::error::{quote, shown_path};
 use crate::materials::{Material, MaterialKind};
 use crate::math::UvTransform;
@@ -23,6 +23,12 @@ pub(super) fn parse_mtl(bytes: &[u8], path: &Path, warnings: &mut Warnings) -> V
                 "{}:{line}: a NUL byte: binary data, not an MTL text file; its materials are not read",
                 shown_path(path)
             )
+        });
+        return Vec::new();
+    }
+    if has_lone_carriage_returns(bytes) {
+        warnings.push(path, "MTL files with lone carriage returns", || {
+            format!("{}:1: {LONE_CARRIAGE_RETURNS}; its materials are not read", shown_path(path))
         });
         return Vec::new();
     }

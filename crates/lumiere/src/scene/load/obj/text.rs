@@ -13,6 +13,19 @@ pub(super) fn lines(bytes: &[u8]) -> impl Iterator<Item = &[u8]> {
     bytes.split(|&b| b == b'\n')
 }
 
+/// Whether the file's line ends are lone `\r`s (classic Mac OS), which neither parser reads: such
+/// a file is one long first line, with a `\r` inside it followed by more text (a CRLF file's first
+/// line has its `\r` last; a stray one elsewhere ends up inside a statement, which its parser
+/// refuses or warns about with the line's number).
+pub(super) fn has_lone_carriage_returns(bytes: &[u8]) -> bool {
+    let first_line = lines(bytes).next().unwrap_or_default();
+    first_line.windows(2).any(|pair| pair[0] == b'\r' && pair[1] != b'\r')
+}
+
+/// The message for a file [`has_lone_carriage_returns`] refuses.
+pub(super) const LONE_CARRIAGE_RETURNS: &str =
+    "lone carriage-return line ends (classic Mac OS) are not supported: convert the file to LF or CRLF line ends";
+
 /// Whitespace-separated tokens of one line, without allocating. A token that starts with `#` ends
 /// the line: MTL files in the wild put comments after values (`Ka 0.7 0.7 0.7 # White`), while a
 /// `#` inside a token (`Material#1`) is kept. Cloning one looks ahead.
