@@ -2,7 +2,7 @@
 //! needs no file on the machine that renders it), the built-in scene's orbiter, and the view that
 //! frames a scene when no camera is given (the CLI's, from the library).
 
-use std::path::Path;
+use std::path::PathBuf;
 
 use glam::Vec3;
 use lumiere::scene::builtin;
@@ -37,9 +37,9 @@ impl PyCamera {
 
     /// gKit's orbiter camera from the text of an orbiter file (`path` names it in errors).
     #[staticmethod]
-    fn orbiter(text: &[u8], path: &str, width: u32, height: u32) -> PyResult<Self> {
+    fn orbiter(text: &[u8], path: PathBuf, width: u32, height: u32) -> PyResult<Self> {
         check_size(width, height)?;
-        let orbiter = Orbiter::parse(text, Path::new(path)).or_py()?;
+        let orbiter = Orbiter::parse(text, &path).or_py()?;
         Ok(PyCamera { camera: Camera::from_orbiter(&orbiter, width, height) })
     }
 

@@ -49,6 +49,12 @@ def test_the_orbiter_is_read_as_a_regular_file_only(tmp_path):
     ], result.stdout
     (tmp_path / "orbiter.txt").write_text(ORBITER)
     assert lumiere.Camera.orbiter(tmp_path / "orbiter.txt", size=(8, 6)).size == (8, 6)
+    # A file name that is not UTF-8 (as bytes, and as Python decodes it) is a file name all the same.
+    odd = os.fsencode(tmp_path) + b"/orbiter-\xff.txt"
+    with open(odd, "w") as f:
+        f.write(ORBITER)
+    assert lumiere.Camera.orbiter(odd, size=(8, 6)).size == (8, 6)
+    assert lumiere.Camera.orbiter(os.fsdecode(odd), size=(8, 6)).size == (8, 6)
     with pytest.raises(lumiere.LumiereOSError) as error:
         lumiere.Camera.orbiter(tmp_path / "missing.txt")
     assert error.value.errno == 2 and error.value.filename == str(tmp_path / "missing.txt")

@@ -44,7 +44,12 @@ def write_image(path: str, image: "object", exposure: float = 0.0, tonemap: str 
     (exposure, ``aces`` or ``clamp`` tone mapping, sRGB), ``.exr`` or ``.pfm`` (linear), atomically."""
     import numpy as np
 
-    array = np.ascontiguousarray(image, dtype=np.float32)
+    values = np.asarray(image)
+    # Numbers only: an object array's None (or a string of digits) would be converted silently,
+    # None to NaN, and written.
+    if values.dtype.kind not in "buif":
+        raise LumiereError(f"image must hold numbers, got an array of {values.dtype}")
+    array = np.ascontiguousarray(values, dtype=np.float32)
     if array.ndim != 3 or array.shape[2] != 3:
         raise LumiereError(f"image must have shape (height, width, 3), got {array.shape}")
     height, width = array.shape[:2]

@@ -16,7 +16,9 @@
 //!   NaN, infinite and huge coordinates read a valid texel and never panic.
 //! * **Loading.** [`TextureSet::load`] decodes every distinct file once, in parallel; a file that
 //!   cannot be read or decoded costs one warning naming it, and the materials that use it keep
-//!   their `Kd`. Image sizes are checked against [`MAX_TEXELS`] from the header, before decoding.
+//!   their `Kd`. Image sizes are checked against [`MAX_TEXELS`] from the header, before decoding,
+//!   and so is the memory each decoding takes, against what is left (in file order, so that
+//!   which files fit never depends on the threads): a file that does not fit is one warning.
 //!
 //! How `World::new` is meant to use it (it does not yet; the world owns the wiring):
 //!
@@ -33,7 +35,7 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use glam::{Vec2, Vec3};
-use image::{DynamicImage, ImageFormat, ImageReader, Limits};
+use image::{DynamicImage, ImageDecoder, ImageFormat, ImageReader, Limits};
 use rayon::prelude::*;
 
 use crate::util::memory::prefetch;
@@ -124,27 +126,7 @@ impl Texture {
     /// As [`Texture::decode`], for the bytes of the file `name`: a TGA file, whose format has no
     /// signature to recognise, is known by its extension.
     pub fn decode_named(bytes: &[u8], name: Option<&Path>) -> Result<Texture, String> {
-        let reader = ImageReader::new(Cursor::new(bytes)).with_guessed_format().map_err(|e| e.to_string())?;
-        let named_tga =
-            name.and_then(|name| name.extension()).is_some_and(|extension| extension.eq_ignore_ascii_case("tga"));
-        let format = match reader.format() {
-            Some(format @ (ImageFormat::Png | ImageFormat::Jpeg | ImageFormat::Bmp)) => format,
-            Some(other) => return Err(format!("{other:?} images are not supported (PNG, JPEG, BMP and TGA are)")),
-            None if named_tga => ImageFormat::Tga,
-            None => return Err("not a PNG, JPEG, BMP or TGA image".to_string()),
-        };
-        let reader = ImageReader::with_format(Cursor::new(bytes), format);
-        let (width, height) = reader.into_dimensions().map_err(|e| e.to_string())?;
-        check_size(width, height)?;
-        let mut reader = ImageReader::with_format(Cursor::new(bytes), format);
-        let mut limits = Limits::default();
-        limits.max_image_width = Some(width);
-        limits.max_image_height = Some(height);
-        // Room for the decoded image at 16 bits per channel and the decoder's own buffers.
-        limits.max_alloc = Some(MAX_TEXELS * 8 + (64 << 20));
-        reader.limits(limits);
-        let image = reader.decode().map_err(|e| e.to_string())?;
-        Ok(Texture::from_image(image))
+        Header::read(bytes, name)?.decode(bytes)
     }
 
     /// A texture from linear texel values, row-major from the top row; `None` when the sizes do
@@ -320,6 +302,61 @@ fn wrap_unit(t: f32) -> f32 {
     if t.is_finite() { t - floor(t) } else { 0.0 }
 }
 
+/// What a texture file's header says, read before decoding it: its format and size (an image of
+/// more than [`MAX_TEXELS`] texels is refused here), and what decoding it will take in memory.
+struct Header {
+    format: ImageFormat,
+    width: u32,
+    height: u32,
+    bytes_per_pixel: u64,
+    sixteen_bits: bool,
+    has_alpha: bool,
+}
+
+impl Header {
+    fn read(bytes: &[u8], name: Option<&Path>) -> Result<Header, String> {
+        let reader = ImageReader::new(Cursor::new(bytes)).with_guessed_format().map_err(|e| e.to_string())?;
+        let named_tga =
+            name.and_then(|name| name.extension()).is_some_and(|extension| extension.eq_ignore_ascii_case("tga"));
+        let format = match reader.format() {
+            Some(format @ (ImageFormat::Png | ImageFormat::Jpeg | ImageFormat::Bmp)) => format,
+            Some(other) => return Err(format!("{other:?} images are not supported (PNG, JPEG, BMP and TGA are)")),
+            None if named_tga => ImageFormat::Tga,
+            None => return Err("not a PNG, JPEG, BMP or TGA image".to_string()),
+        };
+        let decoder = ImageReader::with_format(Cursor::new(bytes), format).into_decoder().map_err(|e| e.to_string())?;
+        let (width, height) = decoder.dimensions();
+        check_size(width, height)?;
+        let colour = decoder.color_type();
+        let (bytes_per_pixel, channels) = (u64::from(colour.bytes_per_pixel()), u64::from(colour.channel_count()));
+        let (sixteen_bits, has_alpha) = (bytes_per_pixel > channels, colour.has_alpha());
+        Ok(Header { format, width, height, bytes_per_pixel, sixteen_bits, has_alpha })
+    }
+
+    /// The most memory decoding takes at once: the decoder's image, its copy as RGBA (none when
+    /// it is RGBA already), and the texels kept (linear `f32` RGB for 16-bit files, 8-bit codes
+    /// otherwise, and alpha where the file has it). A 16-bit RGBA file of 8192 × 8192 texels:
+    /// 1.5 GiB, as `/usr/bin/time` measured its render's peak.
+    fn decoding_bytes(&self) -> u64 {
+        let rgba_size = if self.sixteen_bits { 8 } else { 4 };
+        let copy = if self.bytes_per_pixel == rgba_size { 0 } else { rgba_size };
+        let kept = if self.sixteen_bits { 12 } else { 4 } + if self.has_alpha { 4 } else { 0 };
+        u64::from(self.width) * u64::from(self.height) * (self.bytes_per_pixel + copy + kept)
+    }
+
+    fn decode(&self, bytes: &[u8]) -> Result<Texture, String> {
+        let mut reader = ImageReader::with_format(Cursor::new(bytes), self.format);
+        let mut limits = Limits::default();
+        limits.max_image_width = Some(self.width);
+        limits.max_image_height = Some(self.height);
+        // Room for the decoded image at 16 bits per channel and the decoder's own buffers.
+        limits.max_alloc = Some(MAX_TEXELS * 8 + (64 << 20));
+        reader.limits(limits);
+        let image = reader.decode().map_err(|e| e.to_string())?;
+        Ok(Texture::from_image(image))
+    }
+}
+
 /// Refuses empty images and those of more than [`MAX_TEXELS`] texels.
 fn check_size(width: u32, height: u32) -> Result<(), String> {
     let texels = width as u64 * height as u64;
@@ -384,16 +421,39 @@ impl TextureSet {
         TextureSet::load_or(paths, WITHOUT_DIFFUSE)
     }
 
+    /// [`TextureSet::load`] with `available` bytes of memory, instead of what the system reports
+    /// ([`crate::util::read::available_memory`]): for tests of a machine short of memory.
+    pub fn load_with_memory<P: AsRef<Path> + Sync>(paths: &[P], available: u64) -> (TextureSet, Vec<String>) {
+        TextureSet::load_within(paths, WITHOUT_DIFFUSE, Some(available))
+    }
+
     /// [`TextureSet::load`], whose warnings end with `instead` (what the material does without
     /// the texture).
     fn load_or<P: AsRef<Path> + Sync>(paths: &[P], instead: &str) -> (TextureSet, Vec<String>) {
+        TextureSet::load_within(paths, instead, crate::util::read::available_memory())
+    }
+
+    /// [`TextureSet::load_or`] with `available` bytes of memory (`None`: not known). Each file is
+    /// read and its header checked in order, its decoding's memory ([`Header::decoding_bytes`])
+    /// set aside from what is left; a file that does not fit is refused with a warning, where
+    /// decoding it would have aborted the process. Then the files that fit decode in parallel.
+    /// Which files fit depends on the order alone, never on the threads.
+    fn load_within<P: AsRef<Path> + Sync>(
+        paths: &[P],
+        instead: &str,
+        available: Option<u64>,
+    ) -> (TextureSet, Vec<String>) {
         let mut distinct: Vec<&Path> = Vec::new();
         for path in paths {
             if !distinct.contains(&path.as_ref()) {
                 distinct.push(path.as_ref());
             }
         }
-        let decoded: Vec<Result<Texture, String>> = distinct.par_iter().map(|path| read_texture(path)).collect();
+        let mut left = available;
+        let read: Vec<Result<(Vec<u8>, Header), String>> =
+            distinct.iter().map(|path| read_within(path, &mut left)).collect();
+        let decoded: Vec<Result<Texture, String>> =
+            read.into_par_iter().map(|file| file.and_then(|(bytes, header)| header.decode(&bytes))).collect();
         let mut set = TextureSet::default();
         let mut warnings = Vec::new();
         for (path, result) in distinct.into_iter().zip(decoded) {
@@ -530,11 +590,27 @@ fn check_file(path: &Path) -> Result<(), String> {
     Ok(())
 }
 
-/// Reads and decodes one texture file; the error is a reason without the file name.
-fn read_texture(path: &Path) -> Result<Texture, String> {
+/// Reads one texture file and its header, and sets aside from `left` (bytes of memory, where
+/// known) what the file and its decoding take; the error is a reason without the file name.
+fn read_within(path: &Path, left: &mut Option<u64>) -> Result<(Vec<u8>, Header), String> {
     check_file(path)?;
     let bytes = crate::util::read::read_regular_file(path).map_err(|e| e.to_string())?;
-    Texture::decode_named(&bytes, Some(path))
+    let header = Header::read(&bytes, Some(path))?;
+    if let Some(left) = left {
+        let needed = bytes.len() as u64 + header.decoding_bytes();
+        if needed > *left {
+            let mib = |bytes: u64| bytes.div_ceil(1 << 20);
+            return Err(format!(
+                "decoding its {}×{} texels needs about {} MiB of memory, but only {} MiB is left",
+                header.width,
+                header.height,
+                mib(needed),
+                mib(*left)
+            ));
+        }
+        *left -= needed;
+    }
+    Ok((bytes, header))
 }
 
 #[cfg(test)]

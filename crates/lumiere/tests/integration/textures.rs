@@ -269,6 +269,33 @@ fn unusable_files_cost_one_warning_each_and_no_texture() {
     assert!(warnings[0].contains("odd\\u{1b}[2Jname.png") && !warnings[0].contains('\u{1b}'), "{}", warnings[0]);
 }
 
+/// Textures are decoded only while memory is left for them, in file order: one that does not fit
+/// is a warning (its decoding would have aborted the process, as a 16-bit 8192 × 8192 file did
+/// under a memory limit), and the same files fit in the same order whatever the threads.
+#[test]
+fn textures_that_do_not_fit_in_memory_are_refused_in_order() {
+    let dir = TempDir::new("textures-memory");
+    let image = image::ImageBuffer::<image::Rgb<u16>, _>::from_fn(64, 64, |x, y| {
+        image::Rgb([x as u16 * 999, y as u16 * 999, 7])
+    });
+    let (first, second) = (dir.path("first.png"), dir.path("second.png"));
+    image.save(&first).unwrap();
+    image.save(&second).unwrap();
+    // 64 × 64 texels of 6 bytes, copied as RGBA16 (8), kept as linear f32 RGB (12): 104 KiB each.
+    let (set, warnings) = TextureSet::load_with_memory(&[&first, &second], 200 << 10);
+    assert_eq!(set.len(), 1, "{warnings:?}");
+    assert!(set.id_of(&first).is_some() && set.id_of(&second).is_none());
+    assert_eq!(warnings.len(), 1);
+    assert!(warnings[0].contains("second.png") && warnings[0].contains("64×64 texels needs about"), "{}", warnings[0]);
+    assert!(
+        warnings[0].contains("MiB of memory, but only") && warnings[0].contains("Kd is used instead"),
+        "{}",
+        warnings[0]
+    );
+    let (set, warnings) = TextureSet::load_with_memory(&[&first, &second], 1 << 20);
+    assert_eq!((set.len(), warnings.len()), (2, 0), "{warnings:?}");
+}
+
 /// A PNG whose header claims 20000 × 20000 pixels is refused from the header, before decoding.
 #[test]
 fn absurd_image_sizes_are_refused_before_decoding() {
