@@ -184,6 +184,35 @@ fn killed_and_resumed_renders_give_identical_bytes() {
     assert!(total_kills >= 6, "only {total_kills} kills landed mid-render");
 }
 
+/// A checkpoint that cannot be written mid-render (its folder gone, as a full disk would refuse
+/// it) costs a warning, once, not the render: the passes go on, the image is written, and the
+/// final checkpoint's failure, after it, makes the exit code.
+#[test]
+fn a_checkpoint_that_cannot_be_written_does_not_lose_the_image() {
+    let dir = TempDir::new("checkpoint-fails");
+    fs::create_dir(dir.path("ck")).unwrap();
+    let (checkpoint, out) = (dir.arg("ck/c.ckpt"), dir.arg("o.png"));
+    let args = ["render", "--mode", "ao", "--samples", "4", "--size", "32x24", "--spp", "1000000", "--time", "2s"];
+    let child = Command::new(env!("CARGO_BIN_EXE_lumiere"))
+        .args(args)
+        .args(["--checkpoint", &checkpoint, "-o", &out])
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while fs::metadata(&checkpoint).is_err() {
+        assert!(start.elapsed() < Duration::from_secs(20), "no checkpoint was written");
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    fs::remove_dir_all(dir.path("ck")).unwrap();
+    let run = child.wait_with_output().unwrap();
+    let text = stderr(&run);
+    assert_eq!(run.status.code(), Some(2), "{text}");
+    assert_eq!(text.matches("the checkpoint was not updated").count(), 1, "one warning: {text}");
+    assert!(text.lines().last().unwrap().starts_with("lumiere: error: "), "{text}");
+    assert!(fs::metadata(&out).is_ok_and(|m| m.len() > 0), "the image was written: {text}");
+}
+
 #[test]
 fn resuming_with_other_inputs_or_a_broken_file_is_refused() {
     let dir = TempDir::new("refuse");

@@ -83,9 +83,8 @@ fn render(args: &RenderArgs, threads: usize, denoiser: Option<&oidn::Oidn>) -> R
     }
     report::warn_if_black(&output);
     write_output(args, &world, &camera, &options, &output, denoiser)?;
-    if let Some(path) = &args.checkpoint {
-        fingerprints.save(path, &output.film, &output.stats)?;
-    }
+    // Its error (a full disk) comes after the image, the summary and the statistics are out.
+    let checkpoint = args.checkpoint.as_ref().map(|path| fingerprints.save(path, &output.film, &output.stats));
     report::summary(&options, &camera, &output, threads, &args.output);
     if let Some(path) = &args.stats_json {
         let json = report::stats_json(&world, &options, &camera, &output, threads, &timings)?;
@@ -95,6 +94,7 @@ fn render(args: &RenderArgs, threads: usize, denoiser: Option<&oidn::Oidn>) -> R
             write_atomically(path, json.as_bytes())?;
         }
     }
+    checkpoint.transpose()?;
     Ok(if output.stop == StopReason::Interrupted { EXIT_INTERRUPTED } else { 0 })
 }
 
@@ -156,6 +156,7 @@ fn render_passes(
     let bar = report::progress_bar(pixels * u64::from(options.spp), pixels * u64::from(film.samples));
     let mut last_preview = Instant::now();
     let mut last_checkpoint = Instant::now();
+    let mut checkpoint_failed = false;
     let mut pass_done = |film: &Film, stats: &RenderStats| -> Result<()> {
         if let Some(every) = args.preview_every
             && last_preview.elapsed().as_secs_f64() >= every
@@ -167,7 +168,17 @@ fn render_passes(
         if let Some(path) = &args.checkpoint
             && last_checkpoint.elapsed().as_secs_f64() >= args.checkpoint_every.unwrap_or(0.0)
         {
-            fingerprints.save(path, film, stats)?;
+            // A checkpoint that cannot be written (a full disk) must not cost the render: the
+            // passes go on to the image, the checkpoint written last stays as it was, and the
+            // final checkpoint's error, after the image, makes the exit code.
+            if let Err(e) = fingerprints.save(path, film, stats)
+                && !std::mem::replace(&mut checkpoint_failed, true)
+            {
+                output::warn(format_args!(
+                    "{e}: the checkpoint was not updated after pass {}; the render goes on, and the one written before is left as it was",
+                    film.samples
+                ));
+            }
             last_checkpoint = Instant::now();
         }
         Ok(())
