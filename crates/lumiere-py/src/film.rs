@@ -129,6 +129,15 @@ impl PyFilm {
         camera: &PyCamera,
         options: &PyOptions,
     ) -> PyResult<()> {
+        // The options describe the camera's size: a film of another size would make a checkpoint
+        // that no render can resume.
+        let (film, camera_size) = (&self.film, (camera.camera.width, camera.camera.height));
+        if (film.width, film.height) != camera_size {
+            return Err(invalid(format!(
+                "the film is {}x{}, but the camera's image is {}x{}: a checkpoint holds the film of the camera it names",
+                film.width, film.height, camera_size.0, camera_size.1
+            )));
+        }
         let description = options_description(&options.options, &camera.camera);
         let checkpoint = Checkpoint {
             scene_fingerprint: scene.fingerprint,

@@ -69,3 +69,13 @@ def test_native_pass_ranges_refuse_counts_beyond_their_range():
         _lumiere.render_passes(scene._native, camera._native, options, 0, 2**32, 1)
     with pytest.raises(lumiere.LumiereError, match="first must be an integer between 0 and 4294967295, got -1"):
         _lumiere.render_passes(scene._native, camera._native, options, -1, 1, 1)
+
+
+def test_a_checkpoint_holds_the_film_of_the_camera_it_names(tmp_path):
+    # A film saved with a camera of another size made a checkpoint that no render could resume.
+    film, path = _lumiere.NativeFilm(2, 2), tmp_path / "c.ckpt"
+    options = _lumiere.NativeOptions("hits", 1, 0, None)
+    camera = lumiere.Camera.builtin((3, 2))._native
+    with pytest.raises(lumiere.LumiereError, match=r"the film is 2x2, but the camera's image is 3x2"):
+        film.save_checkpoint(str(path), lumiere.builtin()._native, camera, options)
+    assert not path.exists()

@@ -213,6 +213,26 @@ fn a_checkpoint_that_cannot_be_written_does_not_lose_the_image() {
     assert!(fs::metadata(&out).is_ok_and(|m| m.len() > 0), "the image was written: {text}");
 }
 
+/// A checkpoint whose film is not the size its options name (a film saved apart from them, as
+/// Python's film API can) is refused naming the file, not at the render with a bare message.
+#[test]
+fn a_checkpoint_whose_film_is_another_size_is_refused_by_name() {
+    let dir = TempDir::new("checkpoint-size");
+    let (checkpoint, out) = (dir.arg("c.ckpt"), dir.arg("o.png"));
+    let base = ["render", "--mode", "hits", "--spp", "2", "--size", "3x2", "-o", &out];
+    assert!(lumiere(&[&base[..], &["--checkpoint", &checkpoint]].concat()).status.success());
+    let mut saved = lumiere::render::checkpoint::Checkpoint::load(std::path::Path::new(&checkpoint)).unwrap();
+    saved.film = Film::new(2, 2).unwrap();
+    saved.save(std::path::Path::new(&checkpoint)).unwrap();
+    let run = lumiere(&[&base[..], &["--resume", &checkpoint]].concat());
+    let text = stderr(&run);
+    assert_eq!(run.status.code(), Some(2), "{text}");
+    assert!(
+        text.contains(&format!("{checkpoint}: cannot resume: the checkpoint's film is 2x2, but the image is 3x2")),
+        "{text}"
+    );
+}
+
 #[test]
 fn resuming_with_other_inputs_or_a_broken_file_is_refused() {
     let dir = TempDir::new("refuse");

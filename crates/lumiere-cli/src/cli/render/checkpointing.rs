@@ -35,13 +35,13 @@ impl Fingerprints {
     /// The film and totals to start from: those of the checkpoint `resume`, or fresh ones.
     pub fn start(&self, resume: Option<&Path>, camera: &Camera) -> Result<(Film, RenderStats)> {
         match resume {
-            Some(path) => self.resume(path),
+            Some(path) => self.resume(path, camera),
             None => Ok((Film::new(camera.width, camera.height)?, RenderStats::default())),
         }
     }
 
     /// Loads a checkpoint and refuses it unless it was made from the same scene and options.
-    fn resume(&self, path: &Path) -> Result<(Film, RenderStats)> {
+    fn resume(&self, path: &Path, camera: &Camera) -> Result<(Film, RenderStats)> {
         let checkpoint = Checkpoint::load(path)?;
         if checkpoint.scene_fingerprint != self.scene {
             return Err(Error::invalid(format!(
@@ -55,6 +55,19 @@ impl Fingerprints {
                 "{}: cannot resume: the checkpoint was rendered with other options: {}; only --spp, the budgets, --threads and the outputs may change",
                 shown_path(path),
                 differing.join(", ")
+            )));
+        }
+        // Its options name the camera's size, but its film is written apart (a checkpoint saved
+        // from Python's film API can hold a film of another size): refused here, with the file.
+        let film = &checkpoint.film;
+        if (film.width, film.height) != (camera.width, camera.height) {
+            return Err(Error::invalid(format!(
+                "{}: cannot resume: the checkpoint's film is {}x{}, but the image is {}x{}",
+                shown_path(path),
+                film.width,
+                film.height,
+                camera.width,
+                camera.height
             )));
         }
         Ok((checkpoint.film, checkpoint.stats))
