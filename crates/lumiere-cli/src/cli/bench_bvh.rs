@@ -13,7 +13,7 @@ use lumiere::{Error, Result};
 use super::args::BenchBvhArgs;
 use super::export::export_ray_sets;
 use super::output;
-use super::pool;
+use lumiere::util::threads::pool;
 
 pub fn run(args: &BenchBvhArgs) -> Result<()> {
     let isa = super::isa::choose(args.isa)?;

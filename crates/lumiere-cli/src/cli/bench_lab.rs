@@ -12,7 +12,7 @@ use lumiere::{Error, Result};
 
 use super::args::BenchLabArgs;
 use super::output;
-use super::pool;
+use lumiere::util::threads::pool;
 
 /// One row of the lab's table: what was rendered and the lab's serial and parallel milliseconds.
 struct LabRow {

@@ -26,8 +26,3 @@ pub fn run(cli: Cli) -> Result<u8> {
         Command::BenchSampler(args) => bench_sampler::run(&args).map(|()| 0),
     }
 }
-
-/// A rayon pool of `threads` workers (0: see [`lumiere::util::threads`]).
-fn pool(threads: usize) -> Result<rayon::ThreadPool> {
-    lumiere::util::threads::pool(threads)
-}

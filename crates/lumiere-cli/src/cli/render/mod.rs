@@ -39,7 +39,7 @@ pub fn run(args: &RenderArgs) -> Result<u8> {
     paths::check(args)?;
     // Likewise a denoiser that is not there.
     let denoiser = if args.denoise { Some(oidn::Oidn::load()?) } else { None };
-    let pool = super::pool(args.threads)?;
+    let pool = lumiere::util::threads::pool(args.threads)?;
     let threads = pool.current_num_threads();
     pool.install(|| render(args, threads, denoiser.as_ref()))
 }
