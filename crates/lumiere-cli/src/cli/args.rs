@@ -403,7 +403,9 @@ fn parse_isa(s: &str) -> Result<Isa, String> {
 }
 
 fn parse_emission(s: &str) -> Result<(String, Vec3), String> {
-    let (name, value) = s.split_once('=').ok_or_else(|| format!("expected NAME=r,g,b, got '{s}'"))?;
+    // At the last `=`: a colour never holds one, a material name may (`python -m
+    // lumiere.distributed` splits there too).
+    let (name, value) = s.rsplit_once('=').ok_or_else(|| format!("expected NAME=r,g,b, got '{s}'"))?;
     let ke = parse_vec3(value)?;
     if ke.min_element() < 0.0 {
         return Err(format!("emission must not be negative, got '{value}'"));

@@ -297,6 +297,13 @@ fn emission_names_are_given_once_and_shown_on_one_line() {
         r#"no material named "a\nb""#,
     );
     assert_refused(&dir, &["render", "--size", "8x6", "--emission", "z\u{1b}[2J=1,1,1", "-o", &out], r#""z\u{1b}[2J""#);
+    // A name may hold `=`: the colour follows the last one, as `python -m lumiere.distributed` reads it.
+    fs::write(dir.path("eq.mtl"), "newmtl a=b\nKd 1 1 1\n").unwrap();
+    fs::write(dir.path("eq.obj"), "mtllib eq.mtl\nusemtl a=b\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let args = ["render", &dir.arg("eq.obj"), "--emission", "a=b=1,1,1", "--size", "8x6", "--eye", "0,0,3"];
+    let run = lumiere().args(args).args(["--target", "0,0,0", "-o", &out]).output().unwrap();
+    assert!(run.status.success(), "{}", stderr(&run));
+    assert!(!stderr(&run).contains("black"), "the triangle emits: {}", stderr(&run));
 }
 
 /// A field of view too narrow to frame a scene from a finite distance is named, not taken for
