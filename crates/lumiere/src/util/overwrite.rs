@@ -66,7 +66,7 @@ fn clash(a: &Named, b: &Named, why: &str) -> Error {
 
 /// Whether two paths name one file: the same device and inode when both exist, else the same
 /// absolute path (with its folder resolved).
-pub fn same_file(a: &Path, b: &Path) -> bool {
+fn same_file(a: &Path, b: &Path) -> bool {
     match (std::fs::metadata(a), std::fs::metadata(b)) {
         (Ok(x), Ok(y)) => same_inode(&x, &y),
         (Err(_), Err(_)) => resolved(a).is_some_and(|ra| resolved(b).is_some_and(|rb| ra == rb)),
