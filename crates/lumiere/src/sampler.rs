@@ -245,28 +245,39 @@ impl PointSet<'_> {
     /// once: `WIDE_GROUP`, `NARROW_GROUP`).
     #[inline(always)]
     pub fn get_2d_lanes<const N: usize>(&self, first: u32) -> [Vec2; N] {
+        let [xs, ys] = self.get_2d_rows::<N>(first);
+        let mut points = [Vec2::ZERO; N];
+        for (lane, point) in points.iter_mut().enumerate() {
+            *point = Vec2::new(xs[lane], ys[lane]);
+        }
+        points
+    }
+
+    /// [`PointSet::get_2d_lanes`] as two rows, the points' first coordinates and their second:
+    /// for lane loops that change one coordinate, which stay scalar on interleaved `Vec2`s.
+    #[inline(always)]
+    pub fn get_2d_rows<const N: usize>(&self, first: u32) -> [[f32; N]; 2] {
         let sampler = self.sampler;
         let base = self.first.wrapping_add(first);
-        let mut points = [Vec2::ZERO; N];
+        let (mut xs, mut ys) = ([0.0; N], [0.0; N]);
         match sampler.kind {
             SamplerKind::Independent => {
                 let key = sampler.independent_key(self.pixel, self.dimension);
-                for (lane, point) in points.iter_mut().enumerate() {
+                for lane in 0..N {
                     let bits = independent_bits_in(key, base.wrapping_add(lane as u32));
-                    *point = Vec2::new(unit_f32((bits >> 32) as u32), unit_f32((bits << 24 >> 32) as u32));
+                    (xs[lane], ys[lane]) = (unit_f32((bits >> 32) as u32), unit_f32((bits << 24 >> 32) as u32));
                 }
             }
             SamplerKind::Sobol => {
                 let seeds = SobolSeeds::new(sampler.key, self.pixel, self.dimension);
-                for (lane, point) in points.iter_mut().enumerate() {
+                for lane in 0..N {
                     let i = shuffle(base.wrapping_add(lane as u32), seeds.shuffle);
-                    let x = scrambled_digits(i, seeds.x);
-                    let y = scrambled_digits(sobol_second_digits(i), seeds.y);
-                    *point = Vec2::new(unit_f32(x), unit_f32(y));
+                    xs[lane] = unit_f32(scrambled_digits(i, seeds.x));
+                    ys[lane] = unit_f32(scrambled_digits(sobol_second_digits(i), seeds.y));
                 }
             }
         }
-        points
+        [xs, ys]
     }
 }
 

@@ -122,10 +122,10 @@ impl AmbientOcclusion {
         first: u32,
         left: u32,
     ) -> u32 {
-        let points = directions.points_from::<N>(first);
+        let [xs, azimuths] = directions.points_from::<N>(first);
         let mut dirs = [[0.0; N]; 3];
         for lane in 0..N {
-            let dir = frame.to_world(sample_cosine_hemisphere(points[lane]));
+            let dir = frame.to_world(sample_cosine_hemisphere(Vec2::new(xs[lane], azimuths[lane])));
             [dirs[0][lane], dirs[1][lane], dirs[2][lane]] = dir.to_array();
         }
         let live = u32::MAX >> (32 - left.min(N as u32));
@@ -142,20 +142,21 @@ struct Directions<'a> {
 }
 
 impl Directions<'_> {
-    /// The points of probes `first..first + N`, each with its azimuth number moved into its
-    /// quarter turn when the probes are stratified: probe `i` of quarter `q` turns by
-    /// `(q + u) / 4` of a turn instead of `u`. The same points whatever range they are drawn for.
+    /// The points of probes `first..first + N` as rows (see [`PointSet::get_2d_rows`]), each
+    /// with its azimuth number moved into its quarter turn when the probes are stratified: probe
+    /// `i` of quarter `q` turns by `(q + u) / 4` of a turn instead of `u`. The same points
+    /// whatever range they are drawn for.
     #[inline(always)]
-    fn points_from<const N: usize>(&self, first: u32) -> [Vec2; N] {
-        let mut points: [Vec2; N] = self.points.get_2d_lanes(first);
+    fn points_from<const N: usize>(&self, first: u32) -> [[f32; N]; 2] {
+        let [xs, mut azimuths] = self.points.get_2d_rows::<N>(first);
         if let Some(starts) = self.quarters {
-            for (lane, point) in points.iter_mut().enumerate() {
+            for (lane, azimuth) in azimuths.iter_mut().enumerate() {
                 let probe = first.wrapping_add(lane as u32);
                 let quarter =
                     u32::from(probe >= starts[1]) + u32::from(probe >= starts[2]) + u32::from(probe >= starts[3]);
-                point.y = (quarter as f32 + point.y) * 0.25;
+                *azimuth = (quarter as f32 + *azimuth) * 0.25;
             }
         }
-        points
+        [xs, azimuths]
     }
 }

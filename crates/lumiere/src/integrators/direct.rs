@@ -143,10 +143,17 @@ impl<B: Bsdf> Receiver<'_, B> {
             let visible = trace(world, batch, &segments, traced, ctx);
             // All ones for a visible lane, else zero: the weights are masked bitwise (an unlit
             // lane's may be infinite or NaN, which a product by 0 would keep). Lane `k` is sample
-            // `first + k`, and `first` is a multiple of `NARROW_GROUP`.
-            for lane in 0..N {
-                let keep = 0u32.wrapping_sub((visible >> lane) & 1);
-                weight_sums[lane % NARROW_GROUP] += f32::from_bits(weights[lane].to_bits() & keep);
+            // `first + k`, and `first` is a multiple of `NARROW_GROUP`. Summed a row of
+            // `NARROW_GROUP` at a time, so that each loop vectorises (indexed by `lane %
+            // NARROW_GROUP`, the one loop stayed scalar: 7% of soft shadows N = 64); each sum
+            // still adds its lanes in increasing order.
+            const { assert!(N.is_multiple_of(NARROW_GROUP), "lanes fill whole rows of sums") };
+            for row in 0..N / NARROW_GROUP {
+                for (k, sum) in weight_sums.iter_mut().enumerate() {
+                    let lane = row * NARROW_GROUP + k;
+                    let keep = 0u32.wrapping_sub((visible >> lane) & 1);
+                    *sum += f32::from_bits(weights[lane].to_bits() & keep);
+                }
             }
         } else {
             let (contributions, segments, traced) =
