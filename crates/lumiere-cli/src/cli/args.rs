@@ -268,7 +268,8 @@ pub struct RenderArgs {
     #[arg(long, value_parser = parse_duration, allow_hyphen_values = true)]
     pub time: Option<std::time::Duration>,
 
-    /// Stop once the estimated relative standard error of the image is below this (e.g. 0.01).
+    /// Stop once the estimated relative standard error of the image is below this (e.g. 0.01). A
+    /// target more than an hour away at the render's rate is said once, early.
     #[arg(long, value_parser = parse_positive_f64, allow_hyphen_values = true)]
     pub noise: Option<f64>,
 

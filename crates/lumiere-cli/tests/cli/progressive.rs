@@ -105,6 +105,56 @@ fn time_budget_stops_after_the_crossing_pass_and_says_why() {
     assert!(fs::metadata(&out).unwrap().len() > 0);
 }
 
+/// A noise target hours away at the render's rate is said once, early, with what it would take;
+/// one that a time budget cuts short first is not (the budget ends the render).
+#[test]
+fn a_noise_target_out_of_reach_is_said_once() {
+    use std::io::{BufRead, BufReader};
+    let dir = TempDir::new("noise-forecast");
+    let out = dir.arg("o.png");
+    let mut child =
+        spawn(&["render", "--mode", "ao", "--samples", "4", "--size", "32x24", "--noise", "1e-9", "-o", &out]);
+    let lines = BufReader::new(child.stderr.take().unwrap());
+    let (send, receive) = std::sync::mpsc::channel();
+    let reader = std::thread::spawn(move || {
+        for line in lines.lines().map_while(Result::ok) {
+            let _ = send.send(line);
+        }
+    });
+    let first = receive.recv_timeout(Duration::from_secs(30));
+    signal(&child, "INT");
+    let status = child.wait().unwrap();
+    reader.join().unwrap();
+    let rest: Vec<String> = receive.try_iter().collect();
+    let first = first.expect("a line on stderr within 30 s");
+    assert!(
+        first.starts_with("lumiere: warning: --noise 0.000000001: the relative error is ")
+            && first.contains("years more; the render goes on until then"),
+        "{first}"
+    );
+    assert!(rest.iter().all(|line| !line.contains("--noise")), "one warning: {rest:?}");
+    assert_eq!(status.code(), Some(3), "{rest:?}");
+
+    let run = lumiere(&[
+        "render",
+        "--mode",
+        "ao",
+        "--samples",
+        "4",
+        "--size",
+        "32x24",
+        "--noise",
+        "1e-9",
+        "--time",
+        "3s",
+        "-o",
+        &out,
+    ]);
+    let text = stderr(&run);
+    assert!(run.status.success(), "{text}");
+    assert!(!text.contains("--noise"), "the time budget ends it first: {text}");
+}
+
 /// SIGINT and SIGTERM: the completed samples are written, the summary says so, exit code 3.
 #[test]
 fn interruption_writes_the_completed_samples_and_exits_3() {

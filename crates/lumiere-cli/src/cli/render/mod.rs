@@ -2,6 +2,7 @@
 
 mod camera;
 mod checkpointing;
+mod forecast;
 mod oidn;
 mod options;
 mod paths;
@@ -157,7 +158,11 @@ fn render_passes(
     let mut last_preview = Instant::now();
     let mut last_checkpoint = Instant::now();
     let mut checkpoint_failed = false;
+    let mut forecast = forecast::NoiseForecast::new(args, film.samples);
     let mut pass_done = |film: &Film, stats: &RenderStats| -> Result<()> {
+        if let Some(forecast) = &mut forecast {
+            forecast.after_pass(film);
+        }
         if let Some(every) = args.preview_every
             && last_preview.elapsed().as_secs_f64() >= every
         {
