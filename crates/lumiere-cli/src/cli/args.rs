@@ -94,8 +94,9 @@ pub struct BenchBvhArgs {
     #[arg(long, value_parser = parse_json_path)]
     pub json: Option<PathBuf>,
 
-    /// Write each scene's triangles and ray sets (binary, see bench/README.md) under this folder,
-    /// for bench/embree_compare.py.
+    /// Write each scene's triangles and ray sets (binary, see bench/README.md) under this folder
+    /// (made if missing), each scene's as a folder that replaces the last one whole, for
+    /// bench/embree_compare.py.
     #[arg(long)]
     pub export_rays: Option<PathBuf>,
 }

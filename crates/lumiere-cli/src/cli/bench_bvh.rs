@@ -11,7 +11,7 @@ use lumiere::world::World;
 use lumiere::{Error, Result};
 
 use super::args::BenchBvhArgs;
-use super::export::export_ray_sets;
+use super::export::{export_ray_sets, prepare_export_dir};
 use super::output;
 use lumiere::util::threads::pool;
 
@@ -30,6 +30,9 @@ pub fn run(args: &BenchBvhArgs) -> Result<()> {
             })
         })
         .collect::<Result<_>>()?;
+    if let Some(dir) = &args.export_rays {
+        prepare_export_dir(dir, &scenes.iter().map(|bench| bench.name).collect::<Vec<_>>())?;
+    }
     let threads: Vec<usize> = args.threads.clone();
     let mut builds = Vec::new();
     let mut traces = Vec::new();

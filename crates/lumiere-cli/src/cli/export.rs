@@ -5,16 +5,89 @@
 //! u64 ray count, then per ray 7 f32 (origin, direction, tmax; tmax may be +inf). `<kind>-<query>.expect`:
 //! lumiere's answers, per ray an i32 triangle id (-1 for a miss) for `closest`, a u8 0/1 for `occluded`.
 
-use std::path::Path;
+use std::fs;
+use std::path::{Path, PathBuf};
 
 use crate::bench::rays::{Query, RaySet};
+use lumiere::error::shown_path;
 use lumiere::scene::mesh::TriangleMesh;
-use lumiere::util::write::write_atomically;
+use lumiere::util::write::{check_writable, write_atomically};
 use lumiere::world::World;
 use lumiere::{Error, Result};
 
+/// Makes `dir` (and its parents) if needed and checks that files can be created in it and that
+/// each scene's folder there (`scenes`) is one or does not exist yet: called before any
+/// measurement, so that a bad folder is refused at once, not after minutes.
+pub fn prepare_export_dir(dir: &Path, scenes: &[&str]) -> Result<()> {
+    fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    check_writable(&dir.join("mesh.bin"))?;
+    for scene in scenes {
+        check_scene_dir(&dir.join(scene))?;
+    }
+    Ok(())
+}
+
+/// Refuses a scene folder that exists as anything but a folder (a file, a link): replacing it
+/// would replace what the user put there.
+fn check_scene_dir(dir: &Path) -> Result<()> {
+    match fs::symlink_metadata(dir) {
+        Ok(metadata) if !metadata.is_dir() => Err(Error::invalid(format!(
+            "{}: exists and is not a folder; lumiere replaces only a folder of exported rays there",
+            shown_path(dir)
+        ))),
+        _ => Ok(()),
+    }
+}
+
+/// Writes a scene's set of files as the folder `dir`, whole or not at all: into a temporary
+/// sibling first, which then takes `dir`'s place. A run that fails (a full disk) leaves the last
+/// complete set as it was, and never a folder that mixes two runs' files.
 pub fn export_ray_sets(dir: &Path, world: &World, sets: &[RaySet]) -> Result<()> {
-    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    check_scene_dir(dir)?;
+    let name = dir.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let sibling = |what: &str| dir.with_file_name(format!(".{name}.{what}-{}", std::process::id()));
+    let partial = sibling("partial");
+    // Left by a run of this pid that died (the pid is reused only after that process is gone).
+    let _ = fs::remove_dir_all(&partial);
+    fs::create_dir(&partial).map_err(|e| Error::io(&partial, e))?;
+    if let Err(e) = write_files(&partial, world, sets) {
+        let _ = fs::remove_dir_all(&partial);
+        // Named as the file it was for: the temporary folder is gone.
+        return Err(match e {
+            Error::Io { path, source } => {
+                Error::io(&path.strip_prefix(&partial).map_or(path.clone(), |rest| dir.join(rest)), source)
+            }
+            other => other,
+        });
+    }
+    replace_dir(&partial, dir, &sibling("old"))
+}
+
+/// Moves the complete folder `new` to `dir`, the folder there before (if any) moved aside to
+/// `old` first and removed once `new` is in place, or moved back if that fails.
+fn replace_dir(new: &Path, dir: &Path, old: &PathBuf) -> Result<()> {
+    let had_one = dir.exists();
+    if had_one {
+        let _ = fs::remove_dir_all(old);
+        fs::rename(dir, old).map_err(|e| {
+            let _ = fs::remove_dir_all(new);
+            Error::io(dir, e)
+        })?;
+    }
+    if let Err(e) = fs::rename(new, dir) {
+        let _ = fs::remove_dir_all(new);
+        if had_one {
+            let _ = fs::rename(old, dir);
+        }
+        return Err(Error::io(dir, e));
+    }
+    if had_one {
+        let _ = fs::remove_dir_all(old);
+    }
+    Ok(())
+}
+
+fn write_files(dir: &Path, world: &World, sets: &[RaySet]) -> Result<()> {
     write_atomically(&dir.join("mesh.bin"), &mesh_bytes(&world.scene().mesh))?;
     for set in sets {
         let stem = format!("{}-{}", set.kind, set.query.name());

@@ -279,6 +279,60 @@ fn long_output_names_are_written() {
     assert_eq!(dir.entries(), [name]);
 }
 
+/// `bench-bvh --export-rays` writes a scene's files as one folder, whole or not at all: a run
+/// that fails half-way (here, files capped at 10 MB by `ulimit -f`, as a full disk would stop it)
+/// leaves the last complete set as it was, with no stray folder beside it; the next run replaces
+/// it. A scene folder that is a file is refused before anything is measured.
+#[test]
+fn exported_rays_replace_the_last_set_whole_or_not_at_all() {
+    let dir = TempDir::new("export-rays");
+    let export = ["bench-bvh", "--scenes", "cornell", "--threads", "1", "--repeats", "1", "--export-rays"];
+    let out = run(&[&export[..], &[&dir.arg("rays")]].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let files = |dir: &std::path::Path| {
+        let mut names: Vec<String> =
+            fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+        names.sort();
+        names
+    };
+    let set = files(&dir.path("rays/cornell"));
+    assert_eq!(set.len(), 9, "{set:?}");
+    // Marks the complete set, to tell whether a later run replaced it, or any file of it.
+    fs::write(dir.path("rays/cornell/kept"), "").unwrap();
+    let inodes = || {
+        use std::os::unix::fs::MetadataExt;
+        set.iter().map(|name| fs::metadata(dir.path("rays/cornell").join(name)).unwrap().ino()).collect::<Vec<_>>()
+    };
+    let before = inodes();
+    // A shell that ignores SIGXFSZ, so that the capped write fails with EFBIG rather than killing.
+    let capped = Command::new("sh")
+        .arg("-c")
+        .arg("trap '' XFSZ; ulimit -f 20000; exec \"$@\"")
+        .arg("sh")
+        .arg(env!("CARGO_BIN_EXE_lumiere"))
+        .args(export)
+        .arg(dir.arg("rays"))
+        .output()
+        .unwrap();
+    assert_eq!(capped.status.code(), Some(2), "{}", stderr(&capped));
+    assert!(stderr(&capped).contains("cornell/"), "{}", stderr(&capped));
+    assert!(dir.path("rays/cornell/kept").exists(), "the last set was replaced");
+    assert_eq!(inodes(), before, "files of the last set were replaced");
+    assert_eq!(files(&dir.path("rays")), ["cornell"], "a stray folder was left");
+    let out = run(&[&export[..], &[&dir.arg("rays")]].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(files(&dir.path("rays/cornell")), set, "the set was not replaced whole");
+    assert_eq!(files(&dir.path("rays")), ["cornell"]);
+
+    fs::create_dir(dir.path("other")).unwrap();
+    dir.write("other/cornell", "mine");
+    let out = run(&[&export[..], &[&dir.arg("other")]].concat());
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("exists and is not a folder"), "{}", stderr(&out));
+    assert!(out.stdout.is_empty(), "printed before refusing: {}", String::from_utf8_lossy(&out.stdout));
+    assert_eq!(fs::read(dir.path("other/cornell")).unwrap(), b"mine");
+}
+
 // ---------------------------------------------------------------------------------------------
 // Flags
 
