@@ -5,6 +5,7 @@ use std::sync::{Arc, Mutex};
 
 use lumiere::render::aov::{Aov, render_aovs};
 use lumiere::render::film::Film;
+use lumiere::render::forecast::{NoiseForecast, OutOfReach, shown_duration};
 use lumiere::render::{Hooks, RenderStats, render_progressive};
 use pyo3::prelude::*;
 use pyo3::types::{PyByteArray, PyDict};
@@ -65,7 +66,16 @@ pub fn render<'py>(
             let count = |n| {
                 watch.done.fetch_add(n, std::sync::atomic::Ordering::Relaxed);
             };
-            let hooks = Hooks { progress: &count, pass_done: &mut |_, _| Ok(()), cancel: &watch.cancel };
+            let spp = (options.spp != u32::MAX).then_some(options.spp);
+            let mut forecast = NoiseForecast::new(options.noise_target, spp, options.time_budget, film.samples);
+            let mut pass_done = |film: &Film, _: &RenderStats| {
+                if let Some(report) = forecast.as_mut().and_then(|forecast| forecast.after_pass(film)) {
+                    let message = out_of_reach(options.noise_target.unwrap_or_default(), &report);
+                    watch.warnings.lock().unwrap_or_else(|e| e.into_inner()).push(message);
+                }
+                Ok(())
+            };
+            let hooks = Hooks { progress: &count, pass_done: &mut pass_done, cancel: &watch.cancel };
             let output = render_progressive(world, camera, options, film, RenderStats::default(), hooks)?;
             // Empty when cancelled: `watch::run` then raises, and nothing is returned.
             let buffers = if aovs.is_empty() {
@@ -89,4 +99,15 @@ pub fn render<'py>(
     stats.set_item("threads", threads)?;
     stats.set_item("relative_error", output.film.relative_error())?;
     Ok((image, buffers, stats))
+}
+
+/// The warning for a noise target out of reach, in the Python module's terms.
+fn out_of_reach(target: f64, report: &OutOfReach) -> String {
+    format!(
+        "noise={target}: the relative error is {:.4} after {} spp; at this rate the target needs about {:.2e} spp, {} more; the render goes on until then (time= or spp= bound it)",
+        report.error,
+        report.samples,
+        report.needed_samples,
+        shown_duration(report.seconds_to_target)
+    )
 }

@@ -1,13 +1,16 @@
 //! Long work with the GIL released, still answering Python: the work runs on a thread of its own
 //! while the calling thread sleeps without the GIL, waking every few milliseconds to check for
-//! signals (Ctrl-C raises `KeyboardInterrupt`, as Python code would) and to call the progress
-//! callback. A signal or an exception from the callback sets the cancel flag, which the library
-//! polls inside passes, and is raised once the work has stopped.
+//! signals (Ctrl-C raises `KeyboardInterrupt`, as Python code would), to call the progress
+//! callback and to issue the warnings the work left (`RuntimeWarning`). A signal or an exception
+//! from the callback or a warning (under a filter that makes it one) sets the cancel flag, which
+//! the library polls inside passes, and is raised once the work has stopped.
 
+use std::ffi::CString;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Condvar, Mutex};
 use std::time::Duration;
 
+use pyo3::exceptions::PyRuntimeWarning;
 use pyo3::prelude::*;
 
 use crate::errors::to_py;
@@ -15,10 +18,12 @@ use crate::errors::to_py;
 /// How often the waiting thread checks signals and reports progress.
 const POLL: Duration = Duration::from_millis(25);
 
-/// What the work sees: the cancel flag to pass to the library, and a counter of samples done.
+/// What the work sees: the cancel flag to pass to the library, a counter of samples done, and
+/// the warnings to issue in Python.
 pub struct Watch {
     pub cancel: AtomicBool,
     pub done: AtomicU64,
+    pub warnings: Mutex<Vec<String>>,
 }
 
 /// Runs `work` on a new thread; calls `progress(done, total)` as `watch.done` moves (and once at
@@ -29,7 +34,7 @@ pub fn run<T: Send>(
     progress: Option<&Bound<'_, PyAny>>,
     work: impl FnOnce(&Watch) -> lumiere::Result<T> + Send,
 ) -> PyResult<T> {
-    let watch = Watch { cancel: AtomicBool::new(false), done: AtomicU64::new(0) };
+    let watch = Watch { cancel: AtomicBool::new(false), done: AtomicU64::new(0), warnings: Mutex::new(Vec::new()) };
     let finished = Finished::default();
     let mut failure: Option<PyErr> = None;
     let mut reported = None;
@@ -43,7 +48,10 @@ pub fn run<T: Send>(
         loop {
             let over = py.detach(|| finished.wait(POLL));
             if failure.is_none() {
-                let step = py.check_signals().and_then(|()| report(progress, &watch.done, total, &mut reported));
+                let step = py
+                    .check_signals()
+                    .and_then(|()| warn(py, &watch.warnings))
+                    .and_then(|()| report(progress, &watch.done, total, &mut reported));
                 if let Err(e) = step {
                     watch.cancel.store(true, Ordering::SeqCst);
                     failure = Some(e);
@@ -63,8 +71,21 @@ pub fn run<T: Send>(
         return Err(e);
     }
     let value = result.map_err(to_py)?;
+    warn(py, &watch.warnings)?;
     report(progress, &watch.done, total, &mut reported)?;
     Ok(value)
+}
+
+/// Issues the warnings the work left, as `RuntimeWarning`s of the caller's line; an error where a
+/// filter makes them errors.
+fn warn(py: Python<'_>, warnings: &Mutex<Vec<String>>) -> PyResult<()> {
+    let pending = std::mem::take(&mut *warnings.lock().unwrap_or_else(|e| e.into_inner()));
+    for message in pending {
+        // A message holds no NUL: the library writes numbers and words.
+        let message = CString::new(message.replace('\0', " ")).unwrap_or_default();
+        PyErr::warn(py, &py.get_type::<PyRuntimeWarning>(), &message, 3)?;
+    }
+    Ok(())
 }
 
 /// Calls the callback if the count moved since the last call.

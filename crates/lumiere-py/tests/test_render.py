@@ -9,6 +9,7 @@ import sys
 import textwrap
 import threading
 import time
+import warnings
 
 import numpy as np
 import pytest
@@ -294,6 +295,27 @@ def test_progress_is_reported_and_an_exception_stops_the_render():
     with pytest.raises(Stop):
         lumiere.render(lumiere.builtin(), spp=100_000, size=(64, 48), progress=stop)
     assert time.perf_counter() - start < 10
+
+
+def test_a_noise_target_out_of_reach_is_a_warning_and_a_budget_silences_it():
+    # Hours away at this rate: a RuntimeWarning after about two seconds, issued in the caller's
+    # thread; made an error by a filter, it stops the render as a callback's exception does.
+    start = time.perf_counter()
+
+    def give_up(done, total):
+        # Without the warning the render would never end: fail instead of hanging.
+        if time.perf_counter() - start > 30:
+            raise TimeoutError("no warning within 30 s")
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        with pytest.raises(RuntimeWarning, match=r"noise=0.000000001: the relative error is .* years more; the render goes on"):
+            lumiere.render(lumiere.builtin(), mode="ao", samples=4, spp=None, size=(32, 24), noise=1e-9, progress=give_up)
+    # A time budget that ends the render sooner: no warning.
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        lumiere.render(lumiere.builtin(), mode="ao", samples=4, spp=None, size=(32, 24), noise=1e-9, time=3.0)
+    assert not [w for w in caught if "noise=" in str(w.message)], [str(w.message) for w in caught]
 
 
 def test_the_gil_is_released_while_rendering():

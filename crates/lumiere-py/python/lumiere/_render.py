@@ -170,7 +170,9 @@ def render(
         thread, every few milliseconds while samples are added (``total`` is None with a budget).
         An exception it raises stops the render and propagates.
     :param time: stop after the pass that crosses this many seconds.
-    :param noise: stop once the estimated relative error is below this.
+    :param noise: stop once the estimated relative error is below this. A target more than an
+        hour away at the render's rate, that neither ``spp`` nor ``time`` stops it before, is one
+        ``RuntimeWarning`` early on (the render goes on).
     :param technique_options: ``samples`` (direct, ao: points per light or directions; default
         16), ``light_sampling`` (direct: ``per-light`` or ``power``), ``ao_distance`` (ao),
         ``max_depth`` (path: segments from the camera, default 8, 0 = no limit).

@@ -22,6 +22,7 @@ pub mod aov;
 pub mod checkpoint;
 pub mod film;
 pub mod fingerprint;
+pub mod forecast;
 mod options;
 mod pass;
 pub mod range;

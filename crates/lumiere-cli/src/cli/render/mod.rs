@@ -158,10 +158,10 @@ fn render_passes(
     let mut last_preview = Instant::now();
     let mut last_checkpoint = Instant::now();
     let mut checkpoint_failed = false;
-    let mut forecast = forecast::NoiseForecast::new(args, film.samples);
+    let mut forecast = forecast::noise_forecast(args, film.samples);
     let mut pass_done = |film: &Film, stats: &RenderStats| -> Result<()> {
         if let Some(forecast) = &mut forecast {
-            forecast.after_pass(film);
+            forecast::after_pass(forecast, film);
         }
         if let Some(every) = args.preview_every
             && last_preview.elapsed().as_secs_f64() >= every
