@@ -278,6 +278,22 @@ def test_values_the_cli_would_refuse_are_refused(tmp_path):
     assert (tmp_path / "x.pfm").exists()
 
 
+def test_library_errors_name_the_parameters_not_the_cli_flags():
+    for call, expected in [
+        (lambda: lumiere.Camera.look_at((0, 1, 4), (0, 1, 4)), "camera: the eye and the target are the same point"),
+        (lambda: lumiere.Camera.look_at((0, 1, 4), (0, 1, 0), up=(0, 0, 1)), "camera: the up vector is zero or parallel"),
+        (lambda: lumiere.Camera.look_at((0, 1, 4), (0, 1, 0), fov=200), "camera: the field of view must be in (0, 180)"),
+        (
+            lambda: lumiere.render(lumiere.builtin(), mode="ao", ao_distance=-1, size=(8, 6)),
+            "the ambient occlusion distance must be positive",
+        ),
+    ]:
+        with pytest.raises(lumiere.LumiereError) as raised:
+            call()
+        message = str(raised.value)
+        assert expected in message and "--" not in message, message
+
+
 def test_progress_is_reported_and_an_exception_stops_the_render():
     calls = []
     lumiere.render(lumiere.builtin(), spp=4, size=(64, 48), progress=lambda done, total: calls.append((done, total)))

@@ -621,7 +621,7 @@ fn cli_renders_or_refuses_every_corpus_scene() {
 }
 
 /// An OBJ whose extent overflows f32 (coordinates at +-f32::MAX) is accepted by the parser, but the
-/// default framing then fails with "camera: --eye and --target are the same point", an error about
+/// default framing then fails with "camera: the eye and the target are the same point", an error about
 /// options the user did not give that does not name the file.
 #[test]
 fn cli_huge_extent_scene_gets_an_error_naming_the_file() {

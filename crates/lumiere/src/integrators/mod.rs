@@ -70,10 +70,10 @@ impl Technique {
         match *self {
             Technique::Direct(Direct { samples: 0, .. })
             | Technique::AmbientOcclusion(AmbientOcclusion { samples: 0, .. }) => {
-                Err(Error::invalid("--samples must be at least 1"))
+                Err(Error::invalid("the samples per point (samples) must be at least 1"))
             }
             Technique::AmbientOcclusion(AmbientOcclusion { distance, .. }) if distance.is_nan() || distance <= 0.0 => {
-                Err(Error::invalid(format!("--ao-distance must be positive, got {distance}")))
+                Err(Error::invalid(format!("the ambient occlusion distance must be positive, got {distance}")))
             }
             _ => Ok(()),
         }

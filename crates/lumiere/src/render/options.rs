@@ -50,10 +50,10 @@ impl RenderOptions {
         }
         self.technique.validate()?;
         if self.spp == 0 {
-            return Err(Error::invalid("--spp must be at least 1"));
+            return Err(Error::invalid("the samples per pixel (spp) must be at least 1"));
         }
         if self.noise_target.is_some_and(|n| n.is_nan() || n <= 0.0) {
-            return Err(Error::invalid("--noise must be positive"));
+            return Err(Error::invalid("the noise target must be positive"));
         }
         Ok(())
     }

@@ -149,23 +149,27 @@ impl Camera {
     /// A pinhole at `eye` looking at `target`, with vertical field of view `fov_degrees`.
     pub fn look_at(eye: Vec3, target: Vec3, up: Vec3, fov_degrees: f32, width: u32, height: u32) -> Result<Camera> {
         if !(eye.is_finite() && target.is_finite()) {
-            return Err(Error::invalid(format!("camera: --eye {eye} and --target {target} must be finite")));
+            return Err(Error::invalid(format!("camera: the eye {eye} and the target {target} must be finite")));
         }
         let view = target - eye;
         if !view.is_finite() {
-            return Err(Error::invalid("camera: --eye and --target are too far apart (their difference overflows)"));
+            return Err(Error::invalid(
+                "camera: the eye and the target are too far apart (their difference overflows)",
+            ));
         }
         // Scaled by its largest component first, so that a long but finite view does not overflow
         // its squared length.
         let forward = (view / view.abs().max_element())
             .try_normalize()
-            .ok_or_else(|| Error::invalid("camera: --eye and --target are the same point"))?;
+            .ok_or_else(|| Error::invalid("camera: the eye and the target are the same point"))?;
         let right = forward
             .cross(up)
             .try_normalize()
-            .ok_or_else(|| Error::invalid("camera: --up is zero or parallel to the viewing direction"))?;
+            .ok_or_else(|| Error::invalid("camera: the up vector is zero or parallel to the viewing direction"))?;
         if !(fov_degrees > 0.0 && fov_degrees < 180.0) {
-            return Err(Error::invalid(format!("camera: --fov must be in (0, 180) degrees, got {fov_degrees}")));
+            return Err(Error::invalid(format!(
+                "camera: the field of view must be in (0, 180) degrees, got {fov_degrees}"
+            )));
         }
         let half_height = (fov_degrees.to_radians() / 2.0).tan();
         let half_width = half_height * width as f32 / height as f32;
