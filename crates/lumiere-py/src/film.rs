@@ -46,7 +46,8 @@ pub fn render_passes<'py>(
     let (world, camera, options) = (&*scene.world, &camera.camera, &options.options);
     let pool = pool(threads)?;
     let total = u64::from(camera.width) * u64::from(camera.height) * u64::from(count);
-    let passes = watch::run(py, Some(total), progress.as_ref(), |watch| {
+    // Leaves no warnings: any stack level does.
+    let passes = watch::run(py, Some(total), progress.as_ref(), 1, |watch| {
         let count_samples = |n| {
             watch.done.fetch_add(n, std::sync::atomic::Ordering::Relaxed);
         };

@@ -44,7 +44,8 @@ pub fn pool(threads: usize) -> PyResult<Arc<rayon::ThreadPool>> {
 type Rendered<'py> = (Bound<'py, PyByteArray>, Vec<Bound<'py, PyByteArray>>, Bound<'py, PyDict>);
 
 #[pyfunction]
-#[pyo3(signature = (scene, camera, options, threads, aovs, progress=None))]
+#[pyo3(signature = (scene, camera, options, threads, aovs, progress=None, stacklevel=1))]
+#[expect(clippy::too_many_arguments, reason = "Python's arguments, one each")]
 pub fn render<'py>(
     py: Python<'py>,
     scene: &PyScene,
@@ -53,6 +54,7 @@ pub fn render<'py>(
     threads: usize,
     aovs: Vec<String>,
     progress: Option<Bound<'py, PyAny>>,
+    stacklevel: i32,
 ) -> PyResult<Rendered<'py>> {
     let aovs = aovs.iter().map(|name| Aov::parse(name)).collect::<lumiere::Result<Vec<_>>>().or_py()?;
     let (world, camera, options) = (&*scene.world, &camera.camera, &options.options);
@@ -86,7 +88,7 @@ pub fn render<'py>(
             Ok((output, buffers))
         })
     };
-    let (output, buffers) = watch::run(py, total, progress.as_ref(), work)?;
+    let (output, buffers) = watch::run(py, total, progress.as_ref(), stacklevel, work)?;
     let image = to_bytearray(py, &output.image.pixels)?;
     let buffers = buffers.iter().map(|b| to_bytearray(py, b)).collect::<PyResult<Vec<_>>>()?;
     let stats = PyDict::new(py);

@@ -27,11 +27,13 @@ pub struct Watch {
 }
 
 /// Runs `work` on a new thread; calls `progress(done, total)` as `watch.done` moves (and once at
-/// the end). The result of `work`, or the first signal or callback exception.
+/// the end), and issues the warnings it leaves `stacklevel` frames up from the caller (1: the
+/// caller's line). The result of `work`, or the first signal or callback exception.
 pub fn run<T: Send>(
     py: Python<'_>,
     total: Option<u64>,
     progress: Option<&Bound<'_, PyAny>>,
+    stacklevel: i32,
     work: impl FnOnce(&Watch) -> lumiere::Result<T> + Send,
 ) -> PyResult<T> {
     let watch = Watch { cancel: AtomicBool::new(false), done: AtomicU64::new(0), warnings: Mutex::new(Vec::new()) };
@@ -50,7 +52,7 @@ pub fn run<T: Send>(
             if failure.is_none() {
                 let step = py
                     .check_signals()
-                    .and_then(|()| warn(py, &watch.warnings))
+                    .and_then(|()| warn(py, &watch.warnings, stacklevel))
                     .and_then(|()| report(progress, &watch.done, total, &mut reported));
                 if let Err(e) = step {
                     watch.cancel.store(true, Ordering::SeqCst);
@@ -71,19 +73,19 @@ pub fn run<T: Send>(
         return Err(e);
     }
     let value = result.map_err(to_py)?;
-    warn(py, &watch.warnings)?;
+    warn(py, &watch.warnings, stacklevel)?;
     report(progress, &watch.done, total, &mut reported)?;
     Ok(value)
 }
 
-/// Issues the warnings the work left, as `RuntimeWarning`s of the caller's line; an error where a
-/// filter makes them errors.
-fn warn(py: Python<'_>, warnings: &Mutex<Vec<String>>) -> PyResult<()> {
+/// Issues the warnings the work left, as `RuntimeWarning`s `stacklevel` frames up; an error where
+/// a filter makes them errors.
+fn warn(py: Python<'_>, warnings: &Mutex<Vec<String>>, stacklevel: i32) -> PyResult<()> {
     let pending = std::mem::take(&mut *warnings.lock().unwrap_or_else(|e| e.into_inner()));
     for message in pending {
         // A message holds no NUL: the library writes numbers and words.
         let message = CString::new(message.replace('\0', " ")).unwrap_or_default();
-        PyErr::warn(py, &py.get_type::<PyRuntimeWarning>(), &message, 3)?;
+        PyErr::warn(py, &py.get_type::<PyRuntimeWarning>(), &message, stacklevel)?;
     }
     Ok(())
 }

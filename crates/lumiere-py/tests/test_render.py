@@ -204,8 +204,11 @@ def test_errors_carry_the_cli_message(cli, tmp_path):
         lumiere.render(lumiere.builtin(), spp=1, size=(8, 6), aovs=("speed",))
     with pytest.raises(TypeError, match="technique options are"):
         lumiere.render(lumiere.builtin(), spp=1, sample=3)
-    with pytest.warns(UserWarning, match="samples has no effect"):
-        lumiere.render(lumiere.builtin(), spp=1, size=(8, 6), samples=4)
+    # Ignored options are said at the caller's line, from render() as from render_full().
+    for function in (lumiere.render, lumiere.render_full):
+        with pytest.warns(UserWarning, match="samples has no effect") as caught:
+            function(lumiere.builtin(), spp=1, size=(8, 6), samples=4)
+        assert [w.filename for w in caught] == [__file__]
 
 
 def test_numbers_are_checked_as_the_cli_checks_them(tmp_path):
@@ -327,6 +330,19 @@ def test_a_noise_target_out_of_reach_is_a_warning_and_a_budget_silences_it():
         warnings.simplefilter("error", RuntimeWarning)
         with pytest.raises(RuntimeWarning, match=r"noise=0.000000001: the relative error is .* years more; the render goes on"):
             lumiere.render(lumiere.builtin(), mode="ao", samples=4, spp=None, size=(32, 24), noise=1e-9, progress=give_up)
+    # Issued at the caller's line, from render() as from render_full() (a callback stops them).
+    for function in (lumiere.render, lumiere.render_full):
+        start = time.perf_counter()
+
+        def stop_soon(done, total):
+            if time.perf_counter() - start > 3:
+                raise KeyboardInterrupt
+
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            with pytest.raises(KeyboardInterrupt):
+                function(lumiere.builtin(), mode="ao", samples=4, spp=None, size=(32, 24), noise=1e-9, progress=stop_soon)
+        assert [(w.filename, w.category) for w in caught] == [(__file__, RuntimeWarning)], [str(w.message) for w in caught]
     # A time budget that ends the render sooner: no warning.
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")

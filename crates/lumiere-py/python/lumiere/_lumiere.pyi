@@ -95,8 +95,10 @@ def render(
     threads: int,
     aovs: List[str],
     progress: Optional[_Progress] = None,
+    stacklevel: int = 1,
 ) -> Tuple[bytearray, List[bytearray], Dict[str, Any]]:
-    """The image and AOVs as float32 RGB bytes (row 0 at the top) and the statistics."""
+    """The image and AOVs as float32 RGB bytes (row 0 at the top) and the statistics; its
+    warnings go ``stacklevel`` frames up from the caller (1: the caller's line)."""
 
 def render_passes(
     scene: NativeScene,

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+import sys
 import warnings
 from dataclasses import dataclass, field
 from typing import Any, Callable, Dict, Optional, Sequence, Tuple, Union
@@ -36,6 +38,19 @@ class RenderResult:
     #: ``samples`` per pixel, ``rays``, ``seconds`` (rendering only), ``mrays_per_second``,
     #: ``stop`` (why it stopped), ``discarded`` (invalid samples), ``threads``, ``relative_error``.
     stats: Dict[str, Any] = field(default_factory=dict)
+
+
+_PACKAGE = os.path.dirname(os.path.abspath(__file__)) + os.sep
+
+
+def _stacklevel_outside() -> int:
+    """The ``stacklevel`` that makes a warning issued in the calling function point at the first
+    line outside this package that led to it: the user's call, whether of :func:`render`,
+    :func:`render_full` or :mod:`lumiere.distributed`'s."""
+    level, frame = 1, sys._getframe(1)
+    while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(_PACKAGE):
+        level, frame = level + 1, frame.f_back
+    return level
 
 
 def _array(buffer: bytearray, height: int, width: int) -> np.ndarray:
@@ -74,7 +89,7 @@ def _options(
     sampler = None if sampler is None else _text(sampler, "sampler")
     options = _lumiere.NativeOptions(mode, spp, seed, sampler, time=time, noise=noise, **technique_options)
     for message in options.ignored:
-        warnings.warn(message, stacklevel=3)
+        warnings.warn(message, stacklevel=_stacklevel_outside())
     return options
 
 
@@ -122,8 +137,9 @@ def render_full(
     twice = _first_repeat(aovs)
     if twice is not None:
         raise LumiereError(f"aov {twice!r} is given twice")
+    # The warnings the render issues (a noise target out of reach) point at the user's call.
     image, buffers, stats = _lumiere.render(
-        scene._native, camera._native, options, _threads(threads), list(aovs), progress
+        scene._native, camera._native, options, _threads(threads), list(aovs), progress, _stacklevel_outside()
     )
     height, width = camera.height, camera.width
     outputs = {}
