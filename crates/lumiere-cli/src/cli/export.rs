@@ -44,12 +44,7 @@ fn check_scene_dir(dir: &Path) -> Result<()> {
 /// complete set as it was, and never a folder that mixes two runs' files.
 pub fn export_ray_sets(dir: &Path, world: &World, sets: &[RaySet]) -> Result<()> {
     check_scene_dir(dir)?;
-    let name = dir.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let sibling = |what: &str| dir.with_file_name(format!(".{name}.{what}-{}", std::process::id()));
-    let partial = sibling("partial");
-    // Left by a run of this pid that died (the pid is reused only after that process is gone).
-    let _ = fs::remove_dir_all(&partial);
-    fs::create_dir(&partial).map_err(|e| Error::io(&partial, e))?;
+    let partial = new_sibling(dir, "partial")?;
     if let Err(e) = write_files(&partial, world, sets) {
         let _ = fs::remove_dir_all(&partial);
         // Named as the file it was for: the temporary folder is gone.
@@ -60,28 +55,49 @@ pub fn export_ray_sets(dir: &Path, world: &World, sets: &[RaySet]) -> Result<()>
             other => other,
         });
     }
-    replace_dir(&partial, dir, &sibling("old"))
+    replace_dir(&partial, dir)
 }
 
-/// Moves the complete folder `new` to `dir`, the folder there before (if any) moved aside to
-/// `old` first and removed once `new` is in place, or moved back if that fails.
-fn replace_dir(new: &Path, dir: &Path, old: &PathBuf) -> Result<()> {
-    let had_one = dir.exists();
-    if had_one {
-        let _ = fs::remove_dir_all(old);
-        fs::rename(dir, old).map_err(|e| {
-            let _ = fs::remove_dir_all(new);
-            Error::io(dir, e)
-        })?;
+/// A new empty folder beside `dir`, `.<dir's name>.<what>-<pid>-<n>`, at the first `n` whose name
+/// is free: whatever else is there was not made by this run, and is neither reused nor removed.
+fn new_sibling(dir: &Path, what: &str) -> Result<PathBuf> {
+    let name = dir.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    for n in 0u32.. {
+        let sibling = dir.with_file_name(format!(".{name}.{what}-{}-{n}", std::process::id()));
+        match fs::create_dir(&sibling) {
+            Ok(()) => return Ok(sibling),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+            Err(e) => return Err(Error::io(&sibling, e)),
+        }
     }
+    unreachable!("a free name among 2^32")
+}
+
+/// Moves the complete folder `new` to `dir`. The folder there before, if any, is first renamed
+/// over a new empty sibling (a rename may replace an empty folder), then removed once `new` is in
+/// place, or moved back if that fails.
+fn replace_dir(new: &Path, dir: &Path) -> Result<()> {
+    let old = if dir.exists() {
+        let old = new_sibling(dir, "old").inspect_err(|_| {
+            let _ = fs::remove_dir_all(new);
+        })?;
+        if let Err(e) = fs::rename(dir, &old) {
+            let _ = fs::remove_dir_all(new);
+            let _ = fs::remove_dir(&old);
+            return Err(Error::io(dir, e));
+        }
+        Some(old)
+    } else {
+        None
+    };
     if let Err(e) = fs::rename(new, dir) {
         let _ = fs::remove_dir_all(new);
-        if had_one {
+        if let Some(old) = &old {
             let _ = fs::rename(old, dir);
         }
         return Err(Error::io(dir, e));
     }
-    if had_one {
+    if let Some(old) = old {
         let _ = fs::remove_dir_all(old);
     }
     Ok(())
