@@ -5,7 +5,7 @@ use std::sync::{Arc, Mutex};
 
 use lumiere::render::aov::{Aov, render_aovs};
 use lumiere::render::film::Film;
-use lumiere::render::forecast::{NoiseForecast, OutOfReach, shown_duration};
+use lumiere::render::forecast::{NoiseForecast, OutOfReach, shown_number};
 use lumiere::render::{Hooks, RenderStats, render_progressive};
 use pyo3::prelude::*;
 use pyo3::types::{PyByteArray, PyDict};
@@ -106,10 +106,10 @@ pub fn render<'py>(
 /// The warning for a noise target out of reach, in the Python module's terms.
 fn out_of_reach(target: f64, report: &OutOfReach) -> String {
     format!(
-        "noise={target}: the relative error is {:.4} after {} spp; at this rate the target needs about {:.2e} spp, {} more; the render goes on until then (time= or spp= bound it)",
+        "noise={}: the relative error is {:.4} after {} spp; at this rate the target needs {}; the render goes on until then (time= or spp= bound it)",
+        shown_number(target),
         report.error,
         report.samples,
-        report.needed_samples,
-        shown_duration(report.seconds_to_target)
+        report.need()
     )
 }

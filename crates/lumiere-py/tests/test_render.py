@@ -328,7 +328,7 @@ def test_a_noise_target_out_of_reach_is_a_warning_and_a_budget_silences_it():
 
     with warnings.catch_warnings():
         warnings.simplefilter("error", RuntimeWarning)
-        with pytest.raises(RuntimeWarning, match=r"noise=0.000000001: the relative error is .* years more; the render goes on"):
+        with pytest.raises(RuntimeWarning, match=r"noise=1e-9: the relative error is .* years more; the render goes on"):
             lumiere.render(lumiere.builtin(), mode="ao", samples=4, spp=None, size=(32, 24), noise=1e-9, progress=give_up)
     # Issued at the caller's line, from render() as from render_full() (a callback stops them).
     for function in (lumiere.render, lumiere.render_full):

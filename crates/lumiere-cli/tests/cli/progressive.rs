@@ -128,7 +128,7 @@ fn a_noise_target_out_of_reach_is_said_once() {
     let rest: Vec<String> = receive.try_iter().collect();
     let first = first.expect("a line on stderr within 30 s");
     assert!(
-        first.starts_with("lumiere: warning: --noise 0.000000001: the relative error is ")
+        first.starts_with("lumiere: warning: --noise 1e-9: the relative error is ")
             && first.contains("years more; the render goes on until then"),
         "{first}"
     );

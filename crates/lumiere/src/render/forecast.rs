@@ -32,6 +32,18 @@ pub struct OutOfReach {
     pub seconds_to_target: f64,
 }
 
+impl OutOfReach {
+    /// What the target needs, in words: "about 4.63e17 spp, 3.85e6 years more", or, for a target
+    /// so low that the count overflows, that it is beyond counting.
+    pub fn need(&self) -> String {
+        if self.needed_samples.is_finite() && self.seconds_to_target.is_finite() {
+            format!("about {:.2e} spp, {} more", self.needed_samples, shown_duration(self.seconds_to_target))
+        } else {
+            "more spp than a 64-bit float counts, forever in practice".to_string()
+        }
+    }
+}
+
 pub struct NoiseForecast {
     target: f64,
     /// The sample count that stops the render, if one does.
@@ -101,6 +113,12 @@ impl NoiseForecast {
     }
 }
 
+/// `x` as a person would write it: with an exponent when small or large (`1e-9`, not
+/// `0.000000001`), as given when it has a short decimal form (`0.01`).
+pub fn shown_number(x: f64) -> String {
+    if x != 0.0 && !(1e-4..1e6).contains(&x.abs()) { format!("{x:e}") } else { format!("{x}") }
+}
+
 /// `seconds` in the largest unit that keeps it above 1, roughly: hours, days or years.
 pub fn shown_duration(seconds: f64) -> String {
     const DAY: f64 = 86_400.0;
@@ -113,7 +131,31 @@ pub fn shown_duration(seconds: f64) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::shown_duration;
+    use super::{OutOfReach, shown_duration, shown_number};
+
+    #[test]
+    fn numbers_read_as_written() {
+        assert_eq!(shown_number(1e-9), "1e-9");
+        assert_eq!(shown_number(1e-300), "1e-300");
+        assert_eq!(shown_number(0.01), "0.01");
+        assert_eq!(shown_number(0.0005), "0.0005");
+        assert_eq!(shown_number(2.5e7), "2.5e7");
+    }
+
+    #[test]
+    fn a_need_beyond_counting_says_so() {
+        let report = |needed_samples, seconds_to_target| OutOfReach {
+            error: 0.01,
+            samples: 8,
+            needed_samples,
+            seconds_to_target,
+        };
+        assert_eq!(report(4.63e17, 1.2e14).need(), "about 4.63e17 spp, 3.80e6 years more");
+        assert_eq!(
+            report(f64::INFINITY, f64::INFINITY).need(),
+            "more spp than a 64-bit float counts, forever in practice"
+        );
+    }
 
     #[test]
     fn durations_read_in_hours_days_or_years() {

@@ -2,7 +2,7 @@
 //! (the library's [`NoiseForecast`] projects it).
 
 use lumiere::render::film::Film;
-use lumiere::render::forecast::{NoiseForecast, shown_duration};
+use lumiere::render::forecast::{NoiseForecast, shown_number};
 
 use crate::cli::args::RenderArgs;
 use crate::cli::output;
@@ -18,12 +18,11 @@ pub fn noise_forecast(args: &RenderArgs, film_samples: u32) -> Option<NoiseForec
 pub fn after_pass(forecast: &mut NoiseForecast, film: &Film) {
     if let Some(report) = forecast.after_pass(film) {
         output::warn(format!(
-            "--noise {}: the relative error is {:.4} after {} spp; at this rate the target needs about {:.2e} spp, {} more; the render goes on until then (Ctrl-C writes the image so far; --time or --spp bound it)",
-            forecast.target(),
+            "--noise {}: the relative error is {:.4} after {} spp; at this rate the target needs {}; the render goes on until then (Ctrl-C writes the image so far; --time or --spp bound it)",
+            shown_number(forecast.target()),
             report.error,
             report.samples,
-            report.needed_samples,
-            shown_duration(report.seconds_to_target)
+            report.need()
         ));
     }
 }
