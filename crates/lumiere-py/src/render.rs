@@ -5,7 +5,7 @@ use std::sync::{Arc, Mutex};
 
 use lumiere::render::aov::{Aov, render_aovs};
 use lumiere::render::film::Film;
-use lumiere::render::forecast::{NoiseForecast, OutOfReach, shown_number};
+use lumiere::render::forecast::{NoiseForecast, shown_number};
 use lumiere::render::{Hooks, RenderStats, render_progressive};
 use pyo3::prelude::*;
 use pyo3::types::{PyByteArray, PyDict};
@@ -72,7 +72,11 @@ pub fn render<'py>(
             let mut forecast = NoiseForecast::new(options.noise_target, spp, options.time_budget, film.samples);
             let mut pass_done = |film: &Film, _: &RenderStats| {
                 if let Some(report) = forecast.as_mut().and_then(|forecast| forecast.after_pass(film)) {
-                    let message = out_of_reach(options.noise_target.unwrap_or_default(), &report);
+                    let message = format!(
+                        "noise={}: {} (time= or spp= bound it)",
+                        shown_number(report.target),
+                        report.describe()
+                    );
                     watch.warnings.lock().unwrap_or_else(|e| e.into_inner()).push(message);
                 }
                 Ok(())
@@ -101,15 +105,4 @@ pub fn render<'py>(
     stats.set_item("threads", threads)?;
     stats.set_item("relative_error", output.film.relative_error())?;
     Ok((image, buffers, stats))
-}
-
-/// The warning for a noise target out of reach, in the Python module's terms.
-fn out_of_reach(target: f64, report: &OutOfReach) -> String {
-    format!(
-        "noise={}: the relative error is {:.4} after {} spp; at this rate the target needs {}; the render goes on until then (time= or spp= bound it)",
-        shown_number(target),
-        report.error,
-        report.samples,
-        report.need()
-    )
 }

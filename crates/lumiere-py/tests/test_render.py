@@ -147,6 +147,7 @@ def test_texture_warnings_reach_python_as_the_cli_prints_them(cli, tmp_path):
     expected = f'texture "{missing}": No such file or directory (os error 2); the material\'s Kd is used instead'
     assert scene.warnings == [expected] and scene.info()["warnings"] == [expected]
     assert [str(w.message) for w in caught] == [expected]
+    assert [w.filename for w in caught] == [__file__]
     printed = cli("render", obj, "--mode", "materials", "--size", "8x6", "-o", tmp_path / "x.pfm").stderr
     assert f"lumiere: warning: {expected}" in printed.splitlines()
 

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import os
-import sys
 import warnings
 from dataclasses import dataclass, field
 from typing import Any, Callable, Dict, Optional, Sequence, Tuple, Union
@@ -11,7 +9,7 @@ from typing import Any, Callable, Dict, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from . import _lumiere
-from ._scene import DEFAULT_SIZE, Camera, Scene, _first_repeat, _integer, _number, _text
+from ._scene import DEFAULT_SIZE, Camera, Scene, _first_repeat, _integer, _number, _stacklevel_outside, _text
 from .errors import LumiereError
 
 __all__ = ["render", "render_full", "RenderResult", "MODES", "AOVS", "TECHNIQUE_OPTIONS"]
@@ -38,19 +36,6 @@ class RenderResult:
     #: ``samples`` per pixel, ``rays``, ``seconds`` (rendering only), ``mrays_per_second``,
     #: ``stop`` (why it stopped), ``discarded`` (invalid samples), ``threads``, ``relative_error``.
     stats: Dict[str, Any] = field(default_factory=dict)
-
-
-_PACKAGE = os.path.dirname(os.path.abspath(__file__)) + os.sep
-
-
-def _stacklevel_outside() -> int:
-    """The ``stacklevel`` that makes a warning issued in the calling function point at the first
-    line outside this package that led to it: the user's call, whether of :func:`render`,
-    :func:`render_full` or :mod:`lumiere.distributed`'s."""
-    level, frame = 1, sys._getframe(1)
-    while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(_PACKAGE):
-        level, frame = level + 1, frame.f_back
-    return level
 
 
 def _array(buffer: bytearray, height: int, width: int) -> np.ndarray:

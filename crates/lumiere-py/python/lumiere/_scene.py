@@ -257,14 +257,26 @@ _SCENES: "OrderedDict[tuple, _lumiere.NativeScene]" = OrderedDict()
 _SCENES_KEPT = 4
 
 
+_PACKAGE = os.path.dirname(os.path.abspath(__file__)) + os.sep
+
+
+def _stacklevel_outside() -> int:
+    """The ``stacklevel`` that makes a warning issued in the calling function point at the first
+    line outside this package that led to it: the user's call, whichever of the package's
+    functions it went through (:func:`render` calls :func:`render_full`, for one)."""
+    level, frame = 1, sys._getframe(1)
+    while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(_PACKAGE):
+        level, frame = level + 1, frame.f_back
+    return level
+
+
 def _made(native: "_lumiere.NativeScene", how: tuple) -> Scene:
     """A scene made in this process from ``how`` (a recipe less the fingerprint), its warnings
     issued as the CLI prints them. The recipe records the fingerprint, so that a process
     rebuilding it can tell a scene it cached from an older version of the file (see
     :func:`_rebuild_scene`)."""
     for message in native.warnings:
-        # stacklevel: the caller of load(), builtin() or Scene.from_arrays().
-        warnings.warn(message, stacklevel=3)
+        warnings.warn(message, stacklevel=_stacklevel_outside())
     return Scene(native, (*how, native.fingerprint))
 
 

@@ -22,6 +22,8 @@ const MIN_PASSES: u32 = 4;
 /// A noise target out of reach: where the render stands and what the target needs.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct OutOfReach {
+    /// The noise target.
+    pub target: f64,
     /// The image's estimated relative error now.
     pub error: f64,
     /// Samples per pixel done.
@@ -33,9 +35,21 @@ pub struct OutOfReach {
 }
 
 impl OutOfReach {
-    /// What the target needs, in words: "about 4.63e17 spp, 3.85e6 years more", or, for a target
-    /// so low that the count overflows, that it is beyond counting.
-    pub fn need(&self) -> String {
+    /// The report, less how the caller names the target and how a render is bounded (a flag, a
+    /// keyword): "the relative error is 0.0078 after 7625 spp; at this rate the target needs about
+    /// 4.63e17 spp, 3.85e6 years more; the render goes on until then".
+    pub fn describe(&self) -> String {
+        format!(
+            "the relative error is {:.4} after {} spp; at this rate the target needs {}; the render goes on until then",
+            self.error,
+            self.samples,
+            self.need()
+        )
+    }
+
+    /// What the target needs, in words, or, for a target so low that the count overflows, that it
+    /// is beyond counting.
+    fn need(&self) -> String {
         if self.needed_samples.is_finite() && self.seconds_to_target.is_finite() {
             format!("about {:.2e} spp, {} more", self.needed_samples, shown_duration(self.seconds_to_target))
         } else {
@@ -74,11 +88,6 @@ impl NoiseForecast {
         })
     }
 
-    /// The noise target.
-    pub fn target(&self) -> f64 {
-        self.target
-    }
-
     /// Called after each pass: at each look, the target if it is out of reach (more than an hour
     /// away at this run's rate, and neither the sample count nor the time budget stops the render
     /// before it); once, then never again.
@@ -109,7 +118,7 @@ impl NoiseForecast {
         if stopped_sooner || seconds_to_target < REPORT_AFTER.as_secs_f64() {
             return None;
         }
-        Some(OutOfReach { error, samples: film.samples, needed_samples, seconds_to_target })
+        Some(OutOfReach { target: self.target, error, samples: film.samples, needed_samples, seconds_to_target })
     }
 }
 
@@ -120,7 +129,7 @@ pub fn shown_number(x: f64) -> String {
 }
 
 /// `seconds` in the largest unit that keeps it above 1, roughly: hours, days or years.
-pub fn shown_duration(seconds: f64) -> String {
+fn shown_duration(seconds: f64) -> String {
     const DAY: f64 = 86_400.0;
     match seconds {
         s if s >= 365.0 * DAY => format!("{:.2e} years", s / (365.25 * DAY)),
@@ -145,15 +154,19 @@ mod tests {
     #[test]
     fn a_need_beyond_counting_says_so() {
         let report = |needed_samples, seconds_to_target| OutOfReach {
+            target: 1e-9,
             error: 0.01,
             samples: 8,
             needed_samples,
             seconds_to_target,
         };
-        assert_eq!(report(4.63e17, 1.2e14).need(), "about 4.63e17 spp, 3.80e6 years more");
         assert_eq!(
-            report(f64::INFINITY, f64::INFINITY).need(),
-            "more spp than a 64-bit float counts, forever in practice"
+            report(4.63e17, 1.2e14).describe(),
+            "the relative error is 0.0100 after 8 spp; at this rate the target needs about 4.63e17 spp, 3.80e6 years more; the render goes on until then"
+        );
+        assert_eq!(
+            report(f64::INFINITY, f64::INFINITY).describe(),
+            "the relative error is 0.0100 after 8 spp; at this rate the target needs more spp than a 64-bit float counts, forever in practice; the render goes on until then"
         );
     }
 

@@ -18,11 +18,9 @@ pub fn noise_forecast(args: &RenderArgs, film_samples: u32) -> Option<NoiseForec
 pub fn after_pass(forecast: &mut NoiseForecast, film: &Film) {
     if let Some(report) = forecast.after_pass(film) {
         output::warn(format!(
-            "--noise {}: the relative error is {:.4} after {} spp; at this rate the target needs {}; the render goes on until then (Ctrl-C writes the image so far; --time or --spp bound it)",
-            shown_number(forecast.target()),
-            report.error,
-            report.samples,
-            report.need()
+            "--noise {}: {} (Ctrl-C writes the image so far; --time or --spp bound it)",
+            shown_number(report.target),
+            report.describe()
         ));
     }
 }
