@@ -19,7 +19,19 @@ use lumiere::{Error, Result};
 /// each scene's folder there (`scenes`) is one or does not exist yet: called before any
 /// measurement, so that a bad folder is refused at once, not after minutes.
 pub fn prepare_export_dir(dir: &Path, scenes: &[&str]) -> Result<()> {
-    fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    // What is there already, named: `create_dir_all` would only say "File exists".
+    match fs::metadata(dir) {
+        Ok(metadata) if !metadata.is_dir() => {
+            return Err(Error::invalid(format!(
+                "{}: exists and is not a folder (a file, a device or a FIFO); give a folder to export the rays into",
+                shown_path(dir)
+            )));
+        }
+        Err(_) if fs::symlink_metadata(dir).is_ok() => {
+            return Err(Error::invalid(format!("{}: is a link to nothing; give a folder", shown_path(dir))));
+        }
+        _ => fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?,
+    }
     check_writable(&dir.join("mesh.bin"))?;
     for scene in scenes {
         check_scene_dir(&dir.join(scene))?;

@@ -331,6 +331,16 @@ fn exported_rays_replace_the_last_set_whole_or_not_at_all() {
     assert!(stderr(&out).contains("exists and is not a folder"), "{}", stderr(&out));
     assert!(out.stdout.is_empty(), "printed before refusing: {}", String::from_utf8_lossy(&out.stdout));
     assert_eq!(fs::read(dir.path("other/cornell")).unwrap(), b"mine");
+    // An export folder that is a device or a dangling link is named as such, not "File exists".
+    std::os::unix::fs::symlink(dir.path("nowhere"), dir.path("dangling")).unwrap();
+    for (folder, expected) in
+        [("/dev/null".to_string(), "exists and is not a folder"), (dir.arg("dangling"), "is a link to nothing")]
+    {
+        let out = run(&[&export[..], &[&folder]].concat());
+        assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+        assert!(stderr(&out).contains(expected), "{}", stderr(&out));
+        assert!(out.stdout.is_empty(), "printed before refusing: {}", String::from_utf8_lossy(&out.stdout));
+    }
 }
 
 // ---------------------------------------------------------------------------------------------
