@@ -20,11 +20,11 @@ use crate::watch::{self, Watch};
 /// The most worker threads a render may ask for, as the CLI's `--threads`.
 const MAX_THREADS: usize = 1024;
 
-/// A rayon pool of `threads` workers (0: one per core), as the CLI builds it, kept for the next
-/// render with that many: starting threads for every call would cost milliseconds a render. Only
-/// the last pool is kept (its threads live as long as it does), so a notebook that tries one
-/// thread count after another does not pile up threads; a render still running on a replaced
-/// pool keeps it until it ends.
+/// A rayon pool of `threads` workers (0: `RAYON_NUM_THREADS` or one per core), as the CLI builds
+/// it, kept for the next render with that many: starting threads for every call would cost
+/// milliseconds a render. Only the last pool is kept (its threads live as long as it does), so a
+/// notebook that tries one thread count after another does not pile up threads; a render still
+/// running on a replaced pool keeps it until it ends.
 pub fn pool(threads: usize) -> PyResult<Arc<rayon::ThreadPool>> {
     if threads > MAX_THREADS {
         return Err(invalid(format!("threads must be at most {MAX_THREADS}, got {threads}")));

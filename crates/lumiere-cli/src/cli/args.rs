@@ -73,7 +73,7 @@ pub struct BenchBvhArgs {
     #[arg(long, default_value = "../shared/scenes")]
     pub scenes_dir: PathBuf,
 
-    /// Thread counts to measure, comma-separated (each at most 1024; 0 = one per core).
+    /// Thread counts to measure, comma-separated (each at most 1024; 0 = RAYON_NUM_THREADS if set, else one per core).
     #[arg(long, value_delimiter = ',', default_value = "1,2", value_parser = parse_threads)]
     pub threads: Vec<usize>,
 
@@ -225,7 +225,7 @@ pub struct RenderArgs {
     #[arg(long, value_parser = parse_isa)]
     pub isa: Option<Isa>,
 
-    /// Worker threads, at most 1024; 0 = one per core, 1 = serial.
+    /// Worker threads, at most 1024; 0 = RAYON_NUM_THREADS if set, else one per core; 1 = serial.
     #[arg(long, default_value_t = 0, value_parser = parse_threads)]
     pub threads: usize,
 

@@ -90,7 +90,7 @@ def _camera(scene: Scene, camera: Optional[Camera], size: Optional[Tuple[int, in
 
 
 def _threads(threads: int) -> int:
-    # 0 is one per core; at most 1024, as the CLI's --threads.
+    # 0 is RAYON_NUM_THREADS or one per core; at most 1024, as the CLI's --threads.
     return _integer(threads, "threads (0 for one per core)", 0, 1024)
 
 
@@ -162,7 +162,7 @@ def render(
     :param spp: camera samples per pixel (1 = the lab's pixel centres, more are jittered). None
         renders until ``time`` or ``noise`` stops it.
     :param seed: same seed, same values, whatever ``threads``.
-    :param threads: worker threads, 0 = all cores, at most 1024.
+    :param threads: worker threads, 0 = ``RAYON_NUM_THREADS`` if set, else all cores; at most 1024.
     :param sampler: ``independent`` or ``sobol``; by default ``sobol`` for path, ``independent`` for
         the lab's modes (as the CLI).
     :param aovs: names among ``albedo``, ``normal``, ``depth``: the result is then a dict with

@@ -167,10 +167,28 @@ fn create_new(path: &Path) -> std::io::Result<File> {
     OpenOptions::new().write(true).create_new(true).open(path)
 }
 
+/// Gives the temporary `file` the permissions of the file `target` it will replace, if there is
+/// one, and its owner where this process may (root): the rename publishes a new file, which would
+/// otherwise take the umask's permissions and this process's owner, where writing into the old
+/// file, as `cp` does, keeps both. A read-only image re-rendered by root stays read-only, and one
+/// re-rendered for another user stays theirs.
+fn take_identity_of(file: &File, target: &Path) -> std::io::Result<()> {
+    let Ok(metadata) = fs::metadata(target) else { return Ok(()) };
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        // Before the permissions: a change of owner clears set-id bits. Only root may give a file
+        // away; anyone else's replacement is theirs, as a new file of theirs would be.
+        let _ = std::os::unix::fs::fchown(file, Some(metadata.uid()), Some(metadata.gid()));
+    }
+    file.set_permissions(metadata.permissions())
+}
+
 /// Writes and fsyncs before renaming, so that the rename cannot publish a file whose data is still only
 /// in the page cache; the handle is closed before the rename, which Windows requires.
 fn fill_and_rename(mut file: File, temp: &Path, path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     file.write_all(bytes)?;
+    take_identity_of(&file, path)?;
     file.sync_all()?;
     drop(file);
     fs::rename(temp, path)

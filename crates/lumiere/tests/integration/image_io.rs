@@ -238,6 +238,24 @@ fn existing_non_regular_targets_are_refused() {
     }
 }
 
+/// A replaced file keeps its permissions: the rename publishes a new file, which would otherwise
+/// take the umask's (a group-readable or read-only image came back as 0644).
+#[cfg(unix)]
+#[test]
+fn a_replaced_file_keeps_its_permissions() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = TempDir::new("permissions");
+    let path = dir.path("image.bin");
+    for mode in [0o640, 0o600, 0o664] {
+        fs::write(&path, b"old").unwrap();
+        fs::set_permissions(&path, fs::Permissions::from_mode(mode)).unwrap();
+        write_atomically(&path, b"new").unwrap();
+        assert_eq!(fs::read(&path).unwrap(), b"new");
+        assert_eq!(fs::metadata(&path).unwrap().permissions().mode() & 0o7777, mode, "{mode:o}");
+    }
+    assert_eq!(dir.entries(), ["image.bin"]);
+}
+
 /// Temporaries left by a process that no longer runs are removed; those of live processes and
 /// other files are kept.
 #[test]
