@@ -242,6 +242,13 @@ fn encode_png(path: &Path, width: u32, height: u32, pixels: &[Vec3], style: PngS
     Ok(bytes)
 }
 
+/// The exr crate's default lossless encoding (run-length coded tiles of 64x64), with its tiles
+/// stored in increasing order: by default the order is left unspecified and its parallel writer
+/// stores each tile as it finishes, so two writes of one image gave different bytes.
+fn exr_encoding() -> exr::prelude::Encoding {
+    exr::prelude::Encoding { line_order: exr::prelude::LineOrder::Increasing, ..exr::prelude::Encoding::FAST_LOSSLESS }
+}
+
 /// 32-bit float RGB with the exr crate's default lossless compression, so values survive bit for bit.
 fn encode_exr(path: &Path, width: u32, height: u32, pixels: &[Vec3]) -> Result<Vec<u8>> {
     use exr::prelude::{Image, SpecificChannels, Vec2, WritableImage};
@@ -251,7 +258,7 @@ fn encode_exr(path: &Path, width: u32, height: u32, pixels: &[Vec3]) -> Result<V
         (p.x, p.y, p.z)
     });
     let mut cursor = Cursor::new(Vec::new());
-    Image::from_channels((w, height as usize), channels)
+    Image::from_encoded_channels((w, height as usize), exr_encoding(), channels)
         .write()
         .to_buffered(&mut cursor)
         .map_err(|e| Error::invalid(format!("{}: cannot encode EXR: {e}", shown_path(path))))?;
@@ -288,7 +295,7 @@ pub fn write_exr_with_layers(path: &Path, width: u32, height: u32, pixels: &[Vec
         }
     }
     let mut cursor = Cursor::new(Vec::new());
-    Image::from_channels((width as usize, height as usize), AnyChannels::sort(channels.into()))
+    Image::from_encoded_channels((width as usize, height as usize), exr_encoding(), AnyChannels::sort(channels.into()))
         .write()
         .to_buffered(&mut cursor)
         .map_err(|e| Error::invalid(format!("{}: cannot encode EXR: {e}", shown_path(path))))?;

@@ -7,7 +7,9 @@ use std::path::Path;
 use crate::common::TempDir;
 use glam::Vec3;
 use lumiere::Error;
-use lumiere::image_io::{PngEncoding, PngStyle, Tonemap, check_output_path, linear_to_srgb8, write_image};
+use lumiere::image_io::{
+    ExrLayer, PngEncoding, PngStyle, Tonemap, check_output_path, linear_to_srgb8, write_exr_with_layers, write_image,
+};
 use lumiere::util::write::{remove_stale_temporaries, write_atomically};
 
 /// The reference: IEC 61966-2-1 in f64, rounded to nearest.
@@ -102,6 +104,36 @@ fn png_gkit_linear_truncates_without_gamma() {
     let img = image::load_from_memory(&bytes).expect("decode png").to_rgb8();
     let row: Vec<[u8; 3]> = img.pixels().map(|p| p.0).collect();
     assert_eq!(row, [[127; 3], [254; 3], [255; 3], [255; 3], [0, 255, 0]]);
+}
+
+/// One image gives one EXR file, byte for byte: the tiles (64x64, compressed in parallel) are
+/// stored in order, not as they finish. Without the order, two of five writes of this image
+/// already differed.
+#[test]
+fn exr_bytes_do_not_depend_on_the_order_tiles_finish_in() {
+    let dir = TempDir::new("exr-order");
+    let (w, h) = (640u32, 448u32);
+    // Tiles that take different times to compress: flat ones (long runs) and noisy ones.
+    let pixels: Vec<Vec3> = (0..w * h)
+        .map(|i| {
+            let (x, y) = (i % w, i / w);
+            if (x / 64 + y / 64) % 2 == 0 { Vec3::splat(0.5) } else { Vec3::splat(((i * 2_654_435_761) >> 8) as f32) }
+        })
+        .collect();
+    let layer = ExrLayer { name: "albedo", channels: &["R", "G", "B"], pixels: &pixels };
+    let mut firsts: Vec<Vec<u8>> = Vec::new();
+    for round in 0..5 {
+        let (plain, layered) = (dir.path(&format!("plain{round}.exr")), dir.path(&format!("layers{round}.exr")));
+        write_image(&plain, w, h, &pixels, PngEncoding::default()).expect("write exr");
+        write_exr_with_layers(&layered, w, h, &pixels, &[layer]).expect("write exr");
+        let bytes = [fs::read(&plain).unwrap(), fs::read(&layered).unwrap()];
+        if firsts.is_empty() {
+            firsts.extend(bytes);
+        } else {
+            assert!(bytes[0] == firsts[0], "round {round}: the image's EXR changed");
+            assert!(bytes[1] == firsts[1], "round {round}: the layered EXR changed");
+        }
+    }
 }
 
 #[test]
