@@ -264,6 +264,37 @@ fn a_checkpoint_that_cannot_be_written_does_not_lose_the_image() {
     assert!(fs::metadata(&out).is_ok_and(|m| m.len() > 0), "the image was written: {text}");
 }
 
+/// A preview that cannot be written (its folder gone, as a full disk would refuse it) costs a
+/// warning, once, as a checkpoint's does: the render goes on to its budget, and the final image's
+/// write reports its own error. It used to end the render at the first failed preview.
+#[test]
+fn a_preview_that_cannot_be_written_does_not_end_the_render() {
+    let dir = TempDir::new("preview-fails");
+    fs::create_dir(dir.path("out")).unwrap();
+    let out = dir.arg("out/o.png");
+    let args = ["render", "--mode", "ao", "--samples", "4", "--size", "32x24", "--spp", "1000000", "--time", "2s"];
+    let start = Instant::now();
+    let child = Command::new(env!("CARGO_BIN_EXE_lumiere"))
+        .args(args)
+        .args(["--preview-every", "0.01", "-o", &out])
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    while fs::metadata(&out).is_err() {
+        assert!(start.elapsed() < Duration::from_secs(20), "no preview was written");
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    fs::rename(dir.path("out"), dir.path("out-gone")).unwrap();
+    let run = child.wait_with_output().unwrap();
+    let text = stderr(&run);
+    assert_eq!(run.status.code(), Some(2), "{text}");
+    assert_eq!(text.matches("the preview was not written").count(), 1, "one warning: {text}");
+    assert!(text.lines().last().unwrap().starts_with("lumiere: error: "), "{text}");
+    // The render ran to its 2 s budget rather than stopping at the first failed preview.
+    assert!(start.elapsed() >= Duration::from_millis(1900), "ended after {:?}: {text}", start.elapsed());
+    assert!(fs::metadata(dir.path("out-gone/o.png")).is_ok_and(|m| m.len() > 0), "the first preview stays");
+}
+
 /// A checkpoint whose film is not the size its options name (a film saved apart from them, as
 /// Python's film API can) is refused naming the file, not at the render with a bare message.
 #[test]

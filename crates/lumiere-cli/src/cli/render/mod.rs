@@ -157,7 +157,7 @@ fn render_passes(
     let bar = report::progress_bar(pixels * u64::from(options.spp), pixels * u64::from(film.samples));
     let mut last_preview = Instant::now();
     let mut last_checkpoint = Instant::now();
-    let mut checkpoint_failed = false;
+    let (mut preview_failed, mut checkpoint_failed) = (false, false);
     let mut forecast = forecast::noise_forecast(args, film.samples);
     let mut pass_done = |film: &Film, stats: &RenderStats| -> Result<()> {
         if let Some(forecast) = &mut forecast {
@@ -166,8 +166,17 @@ fn render_passes(
         if let Some(every) = args.preview_every
             && last_preview.elapsed().as_secs_f64() >= every
         {
+            // As a checkpoint's: a preview that cannot be written (a full disk for a moment) costs
+            // a warning, not the render; the final image's write reports its own error.
             let image = film.image();
-            write_image(&args.output, image.width, image.height, &image.pixels, png_style(args))?;
+            if let Err(e) = write_image(&args.output, image.width, image.height, &image.pixels, png_style(args))
+                && !std::mem::replace(&mut preview_failed, true)
+            {
+                output::warn(format_args!(
+                    "{e}: the preview was not written after pass {}; the render goes on, and any image already there is left as it was",
+                    film.samples
+                ));
+            }
             last_preview = Instant::now();
         }
         if let Some(path) = &args.checkpoint
@@ -180,7 +189,7 @@ fn render_passes(
                 && !std::mem::replace(&mut checkpoint_failed, true)
             {
                 output::warn(format_args!(
-                    "{e}: the checkpoint was not updated after pass {}; the render goes on, and the one written before is left as it was",
+                    "{e}: the checkpoint was not updated after pass {}; the render goes on, and any checkpoint already there is left as it was",
                     film.samples
                 ));
             }
