@@ -296,7 +296,8 @@ pub fn checkpoint_target(data: &[u8]) -> Result<(), String> {
                 ));
             }
             // Elapsed time goes through `Duration` (nanoseconds): compare everything but it.
-            let mut encoded = checkpoint.encode();
+            let mut encoded =
+                checkpoint.encode().map_err(|e| format!("cannot encode the checkpoint it accepted: {e}"))?;
             let elapsed = 8 + 4 + 8 + 8 + 4 + 4 + 4 + 8 + 8 + 8;
             let mut original = bytes.clone();
             for buffer in [&mut encoded, &mut original] {

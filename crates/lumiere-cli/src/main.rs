@@ -30,7 +30,16 @@ fn refuse_arguments(e: clap::Error) -> ExitCode {
         e.kind(),
         ErrorKind::DisplayHelp | ErrorKind::DisplayVersion | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
     ) {
-        e.exit();
+        // As clap's `exit` does, with its exit code, but a stdout that cannot take the text (a
+        // full disk) is an error, as it is for `info`; a reader gone away (`| head -1`) is not.
+        return match e.print().and_then(|()| std::io::stdout().flush()) {
+            Ok(()) => ExitCode::from(u8::try_from(e.exit_code()).unwrap_or(2)),
+            Err(error) if error.kind() == std::io::ErrorKind::BrokenPipe => ExitCode::SUCCESS,
+            Err(error) => {
+                let _ = writeln!(std::io::stderr().lock(), "lumiere: error: <stdout>: {error}");
+                ExitCode::from(2)
+            }
+        };
     }
     let text = e.render().to_string();
     let line = text

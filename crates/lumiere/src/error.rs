@@ -60,11 +60,28 @@ pub fn quote(name: impl AsRef<[u8]>) -> String {
     }
 }
 
+/// A size of memory as people read one: GiB to one decimal from 1 GiB up, whole MiB below it
+/// (rounded up, so that a size above zero never reads "0"). "0.2 GiB is available" hid that a
+/// refused file of 0.15 GiB and a limit of 0.24 GiB were not the same number.
+pub fn shown_bytes(bytes: impl Into<u128>) -> String {
+    let bytes: u128 = bytes.into();
+    if bytes >= 1 << 30 {
+        format!("{:.1} GiB", bytes as f64 / (1u64 << 30) as f64)
+    } else {
+        format!("{} MiB", bytes.div_ceil(1 << 20))
+    }
+}
+
 /// A path as messages show it: as it is when it prints on one line, otherwise escaped and quoted
-/// like [`quote`] (but never cut), so that a file name with a newline cannot split a message.
+/// like [`quote`] (but never cut), so that a file name with a newline cannot split a message; a
+/// name that is not UTF-8 keeps its bytes as `\xFF` escapes (a lossy `U+FFFD` in their place named
+/// a file no one could find).
 pub fn shown_path(path: &Path) -> String {
-    let text = path.to_string_lossy();
-    if text.chars().any(char::is_control) { format!("{text:?}") } else { text.into_owned() }
+    match path.to_str() {
+        Some(text) if !text.chars().any(char::is_control) => text.to_string(),
+        Some(text) => format!("{text:?}"),
+        None => format!("{path:?}"),
+    }
 }
 
 /// A name (a material's) as messages show it: in single quotes when it prints on one line,

@@ -48,6 +48,16 @@ fn a_full_stdout_is_an_error_not_a_panic() {
     let out = lumiere().args(["info", &scene]).stdout(full).stderr(Stdio::piped()).output().unwrap();
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("<stdout>: No space left on device"), "{}", stderr(&out));
+    // Help and version too: they exited 0 having written nothing.
+    for args in [&["--help"][..], &["-V"], &["render", "-h"], &["help", "render"]] {
+        let full = fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
+        let out = lumiere().args(args).stdout(full).stderr(Stdio::piped()).output().unwrap();
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains("<stdout>: No space left on device"), "{args:?}: {}", stderr(&out));
+    }
+    // Written where it can be, help still exits 0.
+    let out = lumiere().arg("--help").output().unwrap();
+    assert!(out.status.success() && String::from_utf8_lossy(&out.stdout).contains("Usage"), "{}", stderr(&out));
 }
 
 /// Warnings that meet a closed stderr (`2>&1 | head`) must not cost the render.
@@ -495,6 +505,13 @@ fn a_scene_without_emitters_says_why_it_is_black() {
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(stderr(&out).contains("the scene has no emitters"), "{}", stderr(&out));
     assert!(stderr(&out).contains("--emission"), "{}", stderr(&out));
+    // An emitting material whose only triangle has no area: not "make one emit", which was done.
+    let flat = dir.write("flat.obj", "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nv 0 0 0\nf 1 2 3\nusemtl lamp\nf 4 4 4\n");
+    let out =
+        run(&["render", flat.to_str().unwrap(), "--emission", "lamp=1,1,1", "--size", "8x6", "-o", &dir.arg("f.png")]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains(r#"no triangle of the emitting material "lamp" can emit"#), "{}", stderr(&out));
+    assert!(!stderr(&out).contains("make one emit"), "{}", stderr(&out));
 }
 
 #[test]

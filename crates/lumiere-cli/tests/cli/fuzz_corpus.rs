@@ -160,6 +160,30 @@ fn forged_checkpoints_are_refused_for_their_reason() {
     let future = dir.write("future.ckpt", &crate::harness::with_checksum(&future[..future.len() - 8]));
     let message = Checkpoint::load(&future).unwrap_err().to_string();
     assert!(message.contains("unsupported version 9"), "{message}");
+    // With a recomputed checksum, sums no render can hold: a NaN, a negative value, and sums in
+    // a film of no samples (which resumed as a NaN pixel, and as an AO of 1.5).
+    let pixel_value = |pixel: usize, value: usize| 72 + (pixel * 4 + value) * 8;
+    let forged = |samples: u32, change: &[(usize, f64)]| {
+        let mut bytes = crate::harness::raw_checkpoint(3, 2, samples, 1.0, 6);
+        for &(at, v) in change {
+            bytes[at..at + 8].copy_from_slice(&v.to_le_bytes());
+        }
+        crate::harness::with_checksum(&bytes[..bytes.len() - 8])
+    };
+    let impossible = [
+        ("nan.ckpt", forged(4, &[(pixel_value(1, 2), f64::NAN)]), "pixel 1 holds a negative or non-finite sum"),
+        ("negative.ckpt", forged(4, &[(pixel_value(0, 3), -1.0)]), "pixel 0 holds a negative or non-finite sum"),
+        ("infinite.ckpt", forged(4, &[(pixel_value(5, 0), f64::INFINITY)]), "pixel 5 holds a negative or non-finite"),
+        ("no-samples.ckpt", forged(0, &[]), "pixel 0 holds sums in a film of no samples"),
+    ];
+    for (file, bytes, reason) in impossible {
+        let path = dir.write(file, &bytes);
+        let message = Checkpoint::load(&path).map(|_| ()).unwrap_err().to_string();
+        assert!(message.contains("not a valid lumiere checkpoint") && message.contains(reason), "{file}: {message}");
+    }
+    // A film of no samples whose sums are all zero is a checkpoint written before the first pass.
+    let empty = forged(0, &(0..24).map(|value| (72 + value * 8, 0.0)).collect::<Vec<_>>());
+    assert_eq!(Checkpoint::load(&dir.write("empty.ckpt", &empty)).unwrap().film.samples, 0);
 }
 
 /// A checkpoint with a valid checksum whose elapsed time (1e20 s) is finite but does not fit a
@@ -714,6 +738,29 @@ fn cli_absurd_sizes_are_refused_naming_the_memory_needed() {
             assert!(result.elapsed < Duration::from_secs(5), "{size}: refused only after {:?}", result.elapsed);
             assert!(!dir.path("huge.png").exists());
         }
+    }
+}
+
+/// A film that fits beside outputs that do not (AOVs, a checkpoint's encoding) is refused before
+/// rendering, naming them: the AOVs' buffers and EXR layers, allocated after the passes, aborted
+/// with a backtrace (a 4000x3000 render with three AOVs under a 1.5 GB limit), and so did a
+/// checkpoint as large as the film. Under the tests' 2 GiB limit, each film below would fit alone
+/// (1.1 and 1.3 GiB).
+#[test]
+#[cfg(unix)]
+fn outputs_that_do_not_fit_beside_the_film_are_refused_before_rendering() {
+    let dir = TempDir::new("cli-outputs-memory");
+    let cases: [(&[&str], &str, &str); 2] = [
+        (&["--size", "5000x4000", "--aov", "albedo,normal,depth", "-o", "x.exr"], "with its AOVs needs", "x.exr"),
+        (&["--size", "5000x5000", "--checkpoint", "c.ckpt", "-o", "c.png"], "with its checkpoint needs", "c.png"),
+    ];
+    for (extra, expected, output) in cases {
+        let args = [&["render", "--mode", "hits"][..], extra].concat();
+        let result = refuse_size(&dir, &args);
+        let error = error_line(&result).expect("checked by refuse_size");
+        assert!(error.contains(expected), "{error}");
+        assert!(result.elapsed < Duration::from_secs(5), "refused only after {:?}", result.elapsed);
+        assert!(!dir.path(output).exists());
     }
 }
 

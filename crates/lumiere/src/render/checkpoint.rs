@@ -15,6 +15,7 @@ use std::time::Duration;
 use crate::error::{Error, Result};
 use crate::render::RenderStats;
 use crate::render::film::Film;
+use crate::render::pass::out_of_memory;
 use crate::util::hash::hash_bytes;
 use crate::util::write::write_atomically;
 
@@ -37,9 +38,13 @@ pub struct Checkpoint {
 }
 
 impl Checkpoint {
-    pub fn encode(&self) -> Vec<u8> {
+    pub fn encode(&self) -> Result<Vec<u8>> {
         let film = &self.film;
-        let mut out = Vec::with_capacity(HEADER_BYTES + film.pixel_count() * 32 + 4 + self.options.len() + 8);
+        let bytes = HEADER_BYTES + film.pixel_count() * 32 + 4 + self.options.len() + 8;
+        let mut out = Vec::new();
+        // Fallible: a checkpoint as large as the film must not abort a render that fits.
+        out.try_reserve_exact(bytes)
+            .map_err(|_| out_of_memory(film.width, film.height, bytes, "the checkpoint's encoding"))?;
         out.extend_from_slice(MAGIC);
         out.extend_from_slice(&VERSION.to_le_bytes());
         out.extend_from_slice(&self.scene_fingerprint.to_le_bytes());
@@ -60,11 +65,11 @@ impl Checkpoint {
         out.extend_from_slice(self.options.as_bytes());
         let hash = hash_bytes(&out);
         out.extend_from_slice(&hash.to_le_bytes());
-        out
+        Ok(out)
     }
 
     pub fn save(&self, path: &Path) -> Result<()> {
-        write_atomically(path, &self.encode())
+        write_atomically(path, &self.encode()?)
     }
 
     pub fn load(path: &Path) -> Result<Checkpoint> {
@@ -113,6 +118,15 @@ impl Checkpoint {
         };
         let moments = std::iter::from_fn(|| Some(([reader.f64(), reader.f64(), reader.f64()], reader.f64())));
         let film = Film::from_moments(width, height, samples, discarded, moments)?;
+        // The checksum finds accidents, not forgeries: a film no render can hold is refused too.
+        // Kept samples are finite and at least +0 in every channel, so are their sums and
+        // squared luminances, and a film of no samples holds zeros (a NaN or negative sum gave
+        // a NaN pixel reported as "relative error 0", sums over 0 samples an AO of 1.5).
+        let possible = |v: f64| v.is_finite() && v >= 0.0 && (samples > 0 || v == 0.0);
+        if let Some(pixel) = film.moments().position(|(sum, sq)| !sum.into_iter().chain([sq]).all(possible)) {
+            let what = if samples == 0 { "sums in a film of no samples" } else { "a negative or non-finite sum" };
+            return Err(bad(&format!("pixel {pixel} holds {what}")));
+        }
         let stats = RenderStats { rays, elapsed };
         Ok(Checkpoint { scene_fingerprint, options_fingerprint, seed, options, film, stats })
     }
@@ -142,6 +156,33 @@ impl Reader<'_> {
     }
 }
 
+/// An option's value as a user names it, for the refusal's message: the technique's record
+/// (`AmbientOcclusion(AmbientOcclusion { samples: 2, distance: inf })`) as its `--mode` and
+/// settings (`--mode ao (samples: 2, distance: inf)`), the sampler's as its `--sampler` name.
+/// Anything else, or a description from another version that does not parse, stays as written.
+fn readable(key: &str, value: &str) -> String {
+    match key {
+        "technique" => {
+            let (variant, rest) = value.split_once('(').unwrap_or((value, ""));
+            let mode = match variant {
+                "Hits" => "hits",
+                "Materials" => "materials",
+                "Shadows" => "shadows",
+                "Direct" => "direct",
+                "AmbientOcclusion" => "ao",
+                "Path" => "path",
+                _ => return value.to_string(),
+            };
+            match rest.split_once('{').and_then(|(_, fields)| fields.rsplit_once('}')).map(|(f, _)| f.trim()) {
+                Some(fields) if !fields.is_empty() => format!("--mode {mode} ({fields})"),
+                _ => format!("--mode {mode}"),
+            }
+        }
+        "sampler" => value.to_ascii_lowercase(),
+        _ => value.to_string(),
+    }
+}
+
 /// The longest option value a refused resume quotes.
 const QUOTED_VALUE_CHARS: usize = 120;
 
@@ -162,6 +203,7 @@ pub fn differing_options(saved: &str, now: &str) -> Vec<String> {
         .filter_map(|key| {
             let (a, b) = (value(&saved, key), value(&now, key));
             (a != b).then(|| {
+                let (a, b) = (readable(key, &a), readable(key, &b));
                 if a.len().max(b.len()) > QUOTED_VALUE_CHARS {
                     format!("{key} (differs from the checkpoint's)")
                 } else {

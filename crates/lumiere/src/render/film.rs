@@ -11,7 +11,9 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-use crate::error::{Error, Result};
+use super::pass::out_of_memory;
+use crate::error::{Error, Result, shown_bytes};
+use crate::util::memory::try_zeroed_vec;
 
 /// Bytes a pixel costs while rendering: the film (3 sums and a second moment in f64), the buffer a
 /// pass renders into and the final image. Adding the second pass holds the first pass's values, the
@@ -102,7 +104,7 @@ impl Film {
         if width == 0 || height == 0 {
             return Err(Error::invalid(format!("image size {width}x{height} has no pixels")));
         }
-        check_memory(width, height)?;
+        check_memory(width, height, 0, "")?;
         Ok(Film { width, height, accumulated: Accumulated::Nothing, samples: 0, discarded: 0 })
     }
 
@@ -200,15 +202,14 @@ impl Film {
         // Into the layout passes render in (one copy: these values come from elsewhere, and the
         // progressive loop's passes need none).
         let mut values: Vec<[f32; 3]> = pass.values.par_iter().map(|v| v.to_array()).collect();
-        self.add_rendered(&mut values);
-        Ok(())
+        self.add_rendered(&mut values)
     }
 
     /// Adds the next pass, given as one sample per pixel, row by row, as rendered. The first pass
     /// is kept as it is: it is taken out of `values`, which is left empty (the caller allocates
     /// another buffer for the next pass). Later ones are added in parallel, each pixel's sums in
     /// pass order, so the bits do not depend on the thread count; `values` is left as it was.
-    pub(crate) fn add_rendered(&mut self, values: &mut Vec<[f32; 3]>) {
+    pub(crate) fn add_rendered(&mut self, values: &mut Vec<[f32; 3]>) -> Result<()> {
         debug_assert_eq!(values.len(), self.pixel_count());
         let discarded = match &mut self.accumulated {
             Accumulated::Nothing => {
@@ -219,8 +220,11 @@ impl Film {
             Accumulated::One(first) => {
                 // Zeroed by the allocator (pages first touched below, in parallel), then set to the
                 // first pass's sums, `0 + x = x`, before the second pass is added to them.
-                let mut sum = vec![[0.0; 3]; first.len()];
-                let mut sum_sq = vec![0.0; first.len()];
+                let n = first.len();
+                let (width, height) = (self.width, self.height);
+                let sums = || out_of_memory(width, height, n * 32, "the film's sums");
+                let mut sum = try_zeroed_vec(n).ok_or_else(sums)?;
+                let mut sum_sq = try_zeroed_vec(n).ok_or_else(sums)?;
                 let discarded = add_in_parallel(&mut sum, &mut sum_sq, values, Some(first));
                 self.accumulated = Accumulated::Sums { sum, sum_sq };
                 discarded
@@ -229,6 +233,7 @@ impl Film {
         };
         self.discarded += discarded;
         self.samples += 1;
+        Ok(())
     }
 }
 
@@ -279,16 +284,20 @@ fn add_sample(s: &mut [f64; 3], sq: &mut f64, value: [f32; 3]) -> bool {
     valid
 }
 
-/// Refuses sizes whose buffers cannot fit, naming the memory they need.
-fn check_memory(width: u32, height: u32) -> Result<()> {
+/// Refuses a render of `width` x `height` whose buffers cannot fit in the memory left, naming
+/// what it needs: the film's [`BYTES_PER_PIXEL`], and `extra_per_pixel` more for what a front end
+/// keeps beside it, which `extras` names for the message (" with its AOVs": their buffers and EXR
+/// layers, or a checkpoint's encoding). Asked before rendering, so that a render that could not
+/// write its outputs does not run first and then fail to allocate them.
+pub fn check_memory(width: u32, height: u32, extra_per_pixel: u64, extras: &str) -> Result<()> {
     // In u128: width * height * bytes overflows u64 for the largest u32 sizes.
-    let needed = width as u128 * height as u128 * BYTES_PER_PIXEL as u128;
+    let needed = width as u128 * height as u128 * (BYTES_PER_PIXEL + extra_per_pixel) as u128;
     let available = crate::util::read::available_memory().unwrap_or(64 << 30);
     if needed > available as u128 {
         return Err(Error::invalid(format!(
-            "image size {width}x{height} needs {:.1} GiB of memory to render; {:.1} GiB is available",
-            needed as f64 / (1u64 << 30) as f64,
-            available as f64 / (1u64 << 30) as f64
+            "image size {width}x{height}{extras} needs {} of memory to render; {} is available",
+            shown_bytes(needed),
+            shown_bytes(available)
         )));
     }
     Ok(())

@@ -181,15 +181,22 @@ fn run_passes<I: Integrator>(
             }
             let pass = Pass { sampler: &sampler, sample: film.samples, pixel_centre };
             if buffer.is_empty() {
-                buffer = pass_buffer(camera.width, camera.height);
+                match pass_buffer(camera.width, camera.height) {
+                    Ok(fresh) => buffer = fresh,
+                    Err(e) => break (StopReason::Interrupted, Err(e)),
+                }
             }
             let Some(rays) = render_pass(integrator, world, camera, &pass, &mut buffer, hooks.progress, &stop_now)
             else {
                 // The pass in flight is abandoned: the film keeps whole passes only.
                 break (stop_now().unwrap_or(StopReason::Interrupted), Ok(()));
             };
-            film.add_rendered(&mut buffer);
-            stats.rays += rays;
+            if let Err(e) = film.add_rendered(&mut buffer) {
+                break (StopReason::Interrupted, Err(e));
+            }
+            // Saturating: a checkpoint's count may already be near the top (the checksum does not
+            // stop a forged one), and a total is no reason to wrap or panic.
+            stats.rays = stats.rays.saturating_add(rays);
             stats.elapsed = before + start.elapsed();
             if let Err(e) = (hooks.pass_done)(&film, &stats) {
                 break (StopReason::Interrupted, Err(e));

@@ -9,11 +9,12 @@ use rayon::prelude::*;
 
 use super::StopReason;
 use crate::accel::OriginBatch;
+use crate::error::{Error, Result, shown_bytes};
 use crate::integrators::{CameraPacket, Integrator, PACKET, SampleContext};
 use crate::math::Ray;
 use crate::sampler::{SampleStream, Sampler};
 use crate::scene::camera::Camera;
-use crate::util::memory::ask_for_huge_pages;
+use crate::util::memory::{ask_for_huge_pages, try_zeroed_vec};
 use crate::world::World;
 
 /// Tiles are small enough to balance two cores and to notice an interruption within milliseconds,
@@ -37,11 +38,21 @@ pub(super) struct Pass<'a> {
 /// zero arrays is allocated zeroed (calloc), its pages first touched by the workers that write
 /// them, in parallel, where `vec![Vec3::ZERO; n]` fills every pixel on one thread first (4 ms at
 /// 1024x768).
-pub(super) fn pass_buffer(width: u32, height: u32) -> Vec<[f32; 3]> {
-    let buffer = vec![[0.0; 3]; width as usize * height as usize];
+pub(super) fn pass_buffer(width: u32, height: u32) -> Result<Vec<[f32; 3]>> {
+    let len = width as usize * height as usize;
+    let buffer = try_zeroed_vec(len).ok_or_else(|| out_of_memory(width, height, len * 12, "a pass's buffer"))?;
     // Its 2,300 4 KB pages, zeroed at their first touch, were a sixth of a hard-shadow render.
     ask_for_huge_pages(buffer.as_ptr(), buffer.len());
-    buffer
+    Ok(buffer)
+}
+
+/// The error of a render's buffer that the memory left cannot hold (more than the check before
+/// rendering foresaw: other processes took memory meanwhile, or the scene's own did not count).
+pub(crate) fn out_of_memory(width: u32, height: u32, bytes: usize, what: &str) -> Error {
+    Error::invalid(format!(
+        "image size {width}x{height}: out of memory for {what} ({}); render a smaller image, or free memory",
+        shown_bytes(bytes as u64)
+    ))
 }
 
 /// The camera ray of sample `sample` of pixel `(x, y)`, and that sample's random numbers with the

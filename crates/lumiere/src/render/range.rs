@@ -53,7 +53,7 @@ pub fn render_pass_range(
         }
     }
     with_integrator!(&options.technique, integrator => {
-        Ok(run_range(integrator, world, camera, options, first..first + count, progress, cancel))
+        run_range(integrator, world, camera, options, first..first + count, progress, cancel)
     })
 }
 
@@ -65,14 +65,14 @@ fn run_range<I: Integrator>(
     samples: Range<u32>,
     progress: &(dyn Fn(u64) + Sync),
     cancel: &AtomicBool,
-) -> Vec<PassSamples> {
+) -> Result<Vec<PassSamples>> {
     let sampler = Sampler::new(options.sampler, options.seed);
     let pixel_centre = options.samples_pixel_centres();
     let stop_now = || cancel.load(Ordering::Relaxed).then_some(StopReason::Interrupted);
     let mut passes = Vec::with_capacity(samples.len());
     for sample in samples {
         let pass = Pass { sampler: &sampler, sample, pixel_centre };
-        let mut values = pass_buffer(camera.width, camera.height);
+        let mut values = pass_buffer(camera.width, camera.height)?;
         let Some(rays) = render_pass(integrator, world, camera, &pass, &mut values, progress, &stop_now) else {
             break;
         };
@@ -80,5 +80,5 @@ fn run_range<I: Integrator>(
         let values = values.into_iter().map(Vec3::from).collect();
         passes.push(PassSamples { sample, width: camera.width, height: camera.height, values, rays });
     }
-    passes
+    Ok(passes)
 }

@@ -3,6 +3,34 @@
 //! this project's VM, against 7 GB/s for writing memory already touched). Records read soon: a
 //! prefetch, so that other work runs while they come from memory.
 
+/// Types for which all-zero bytes are a valid value: the float buffers a render allocates.
+///
+/// # Safety
+/// Only for types whose every field is a float or an integer.
+pub unsafe trait ZeroIsValid: Copy {}
+// SAFETY: floats, and arrays of them; all-zero bytes are +0.0.
+unsafe impl ZeroIsValid for f64 {}
+// SAFETY: as above.
+unsafe impl ZeroIsValid for [f64; 3] {}
+// SAFETY: as above.
+unsafe impl ZeroIsValid for [f32; 3] {}
+
+/// `vec![zero; len]`, or `None` when the memory cannot be had, where `vec!` would abort the
+/// process: allocated zeroed by the allocator as `vec!` does (fresh pages, zeroed at their first
+/// touch, not written here).
+pub fn try_zeroed_vec<T: ZeroIsValid>(len: usize) -> Option<Vec<T>> {
+    let layout = std::alloc::Layout::array::<T>(len).ok()?;
+    if layout.size() == 0 {
+        return Some(Vec::new());
+    }
+    // SAFETY: the layout has a non-zero size; all-zero bytes are a valid `T`; the pointer comes
+    // from the global allocator with the layout of `len` values, as `Vec::from_raw_parts` needs.
+    unsafe {
+        let pointer = std::alloc::alloc_zeroed(layout).cast::<T>();
+        (!pointer.is_null()).then(|| Vec::from_raw_parts(pointer, len, len))
+    }
+}
+
 /// Asks the kernel to back the `len` values of type `T` at `start`, not yet touched, with 2 MB
 /// pages where it can: with transparent huge pages in `madvise` mode (the common default) one
 /// fault then zeroes 2 MB. Only a request: the answer is ignored, and nothing but speed depends

@@ -6,7 +6,7 @@ use std::fs::File;
 use std::io::{self, Read};
 use std::path::Path;
 
-const GIB: f64 = (1u64 << 30) as f64;
+use crate::error::shown_bytes;
 
 /// Reads the regular file at `path` whole, refusing anything else *before* reading from it.
 ///
@@ -31,9 +31,9 @@ pub fn read_regular_file(path: &Path) -> io::Result<Vec<u8>> {
         return Err(io::Error::new(
             io::ErrorKind::OutOfMemory,
             format!(
-                "is {:.1} GiB, more than the {:.1} GiB of memory available; refusing it",
-                size as f64 / GIB,
-                available as f64 / GIB
+                "is {}, more than the {} of memory available; refusing it",
+                shown_bytes(size),
+                shown_bytes(available)
             ),
         ));
     }
@@ -133,8 +133,8 @@ pub fn gunzip(raw: &[u8], limit: u64) -> io::Result<Vec<u8>> {
             return Err(io::Error::new(
                 io::ErrorKind::OutOfMemory,
                 format!(
-                    "decompresses to more than {:.1} GiB, over a quarter of the free memory; refusing it",
-                    limit as f64 / GIB
+                    "decompresses to more than {}, over a quarter of the free memory; refusing it",
+                    shown_bytes(limit)
                 ),
             ));
         }

@@ -103,7 +103,7 @@ fn checkpoints_of_every_form_resume_exactly() {
             film: film.clone(),
             stats: RenderStats::default(),
         };
-        let mut loaded = Checkpoint::decode(&checkpoint.encode(), Path::new("film.ckpt")).unwrap().film;
+        let mut loaded = Checkpoint::decode(&checkpoint.encode().unwrap(), Path::new("film.ckpt")).unwrap().film;
         assert_eq!(loaded, film, "after {k} passes");
         assert_eq!(image_bits(&loaded), image_bits(&film), "after {k} passes");
         assert_eq!(loaded.relative_error().map(f64::to_bits), film.relative_error().map(f64::to_bits));

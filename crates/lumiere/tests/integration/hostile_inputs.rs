@@ -218,7 +218,8 @@ fn scene_too_big_for_memory_is_refused_before_parsing() {
     assert!(start.elapsed() < Duration::from_secs(5), "took {:?}", start.elapsed());
     assert!(message.starts_with(&format!("{}: needs about ", path.display())), "{message}");
     assert!(message.contains("for its 2097152 triangles and 3 vertices"), "{message}");
-    assert!(message.contains("GiB of memory") && message.contains("only 0.1 GiB is available"), "{message}");
+    // Below 1 GiB in MiB: "0.3 GiB ... only 0.1 GiB" read as if both were rounded to nothing.
+    assert!(message.contains("MiB of memory") && message.contains("only 128 MiB is available"), "{message}");
     assert!(matches!(error, lumiere::Error::Io { ref source, .. } if source.kind() == io::ErrorKind::OutOfMemory));
     // With room enough it loads.
     let scene = load_obj_with_memory(&path, 4 << 30).unwrap();
@@ -312,6 +313,16 @@ fn control_characters_in_names_and_paths_are_escaped() {
     assert!(message.contains(r#"absent\r\n.obj""#), "{message}");
     let scene = Scene::load(&dir.path("x\n.ply")).map(|_| ()).unwrap_err().to_string();
     assert_one_line(&[scene]);
+    // A name that is not UTF-8 keeps its byte as an escape: a U+FFFD in its place named a file no
+    // one could find.
+    #[cfg(unix)]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        let path = dir.0.join(std::ffi::OsStr::from_bytes(b"n\xffl.obj"));
+        std::fs::write(&path, "v 0 0 x\n").unwrap();
+        let message = load_error(&path);
+        assert!(message.contains(r#"n\xFFl.obj""#) && !message.contains('\u{FFFD}'), "{message}");
+    }
 }
 
 /// A folder or a device given as the scene is named for what it is, whatever its name: before,

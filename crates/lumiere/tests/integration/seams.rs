@@ -411,6 +411,8 @@ fn scene_files_are_loaded_by_extension_or_refused_naming_it() {
         ("model.ply", ".ply scenes are not supported"),
         ("model.gltf", ".gltf scenes are not supported"),
         ("noextension", "no extension"),
+        // Not "no extension": the name has one, and what it lacks is the one inside.
+        ("scene.gz", "a gzip file whose name does not say what it holds"),
     ] {
         let path = dir.write(name, "v 0 0 0\n");
         let message = Scene::load(&path).unwrap_err().to_string();

@@ -57,6 +57,7 @@ fn render(args: &RenderArgs, threads: usize, denoiser: Option<&oidn::Oidn>) -> R
     let camera = camera::from_args(args, &scene)?;
     let options = options::from_args(args);
     let fingerprints = Fingerprints::new(&scene, &options, &camera);
+    check_memory_for_outputs(args, &camera)?;
     let (film, stats) = fingerprints.start(args.resume.as_deref(), &camera)?;
     if let Some(resume) = args.resume.as_deref().filter(|_| film.samples > options.spp) {
         // Samples cannot be taken back out of a film: say that the image will have them all.
@@ -201,6 +202,38 @@ fn render_passes(
     let output = render_progressive(world, camera, options, film, stats, hooks);
     bar.finish_and_clear();
     output
+}
+
+/// Refuses, before rendering, a render whose film and outputs together cannot fit in memory: the
+/// film is checked alone when it is made, but AOVs, a denoised image and a checkpoint's encoding
+/// need buffers as large, allocated only once the passes are done (a 4000x3000 render with three
+/// AOVs under a 1.5 GB limit rendered, then aborted).
+fn check_memory_for_outputs(args: &RenderArgs, camera: &Camera) -> Result<()> {
+    // Bytes a pixel costs: an AOV's buffer, its channels copied for the EXR writer and encoded
+    // (12 each); with any layer, the image's own copy and encoding; the denoised image; a
+    // checkpoint's encoding of the film's four f64 values.
+    let mut layers = args.aov.len() as u64;
+    if args.denoise {
+        layers += [Aov::Albedo, Aov::Normal].iter().filter(|aov| !args.aov.contains(aov)).count() as u64;
+    }
+    let mut extra = layers * 36;
+    let mut extras = Vec::new();
+    if layers > 0 {
+        extra += 24;
+        extras.push("AOVs");
+    }
+    if args.denoise {
+        extra += 12;
+        extras.push("denoised image");
+    }
+    if args.checkpoint.is_some() {
+        extra += 32;
+        extras.push("checkpoint");
+    }
+    if extras.is_empty() {
+        return Ok(());
+    }
+    lumiere::render::film::check_memory(camera.width, camera.height, extra, &format!(" with its {}", extras.join(", ")))
 }
 
 /// The image (denoised with `--denoise`), with its AOVs as extra EXR channels when asked for, and

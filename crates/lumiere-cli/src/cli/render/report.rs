@@ -116,6 +116,19 @@ pub fn warn_if_unlit(world: &World, options: &RenderOptions) {
     if !needs_lights || !world.lights().is_empty() {
         return;
     }
+    // Emitting materials whose triangles could not become lights: the advice to make one emit
+    // would be advice already followed.
+    let emitting: Vec<String> =
+        world.scene().materials.iter().filter(|m| m.ke.max_element() > 0.0).map(|m| format!("{:?}", m.name)).collect();
+    if !emitting.is_empty() {
+        output::warn(format_args!(
+            "no triangle of the emitting material{} {} can emit (none uses it, or only triangles of zero area or of an area too large for f32), so --mode {} renders black",
+            if emitting.len() == 1 { "" } else { "s" },
+            emitting.iter().take(5).cloned().collect::<Vec<_>>().join(", "),
+            options.technique.name()
+        ));
+        return;
+    }
     let names: Vec<String> = world.scene().materials.iter().take(5).map(|m| format!("{:?}", m.name)).collect();
     let more = world.scene().materials.len().saturating_sub(names.len());
     let more = if more > 0 { format!(" and {more} more") } else { String::new() };

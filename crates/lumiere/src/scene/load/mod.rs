@@ -29,6 +29,10 @@ pub fn load(path: &Path) -> Result<Scene> {
             "{}: is a material library (.mtl), not a scene; give the .obj file that names it with mtllib",
             shown_path(path)
         ))),
+        "" if stem.len() < name.len() => Err(Error::invalid(format!(
+            "{}: a gzip file whose name does not say what it holds; name a compressed OBJ scene .obj.gz",
+            shown_path(path)
+        ))),
         "" => Err(Error::invalid(format!(
             "{}: the file name has no extension, so its format is unknown; lumiere reads {SUPPORTED}",
             shown_path(path)

@@ -16,7 +16,7 @@ mod mtl;
 mod skipped;
 mod text;
 
-use crate::error::{Error, Result, shown_path};
+use crate::error::{Error, Result, shown_bytes, shown_path};
 use crate::materials::Material;
 use crate::scene::Scene;
 use crate::scene::mesh::{NO_INDEX, TriangleMesh};
@@ -209,13 +209,12 @@ fn check_memory(vertices: VertexCounts, triangles: u64, name: &Path, memory: Mem
     if needed <= available {
         return Ok(());
     }
-    let gib = |bytes: u64| bytes as f64 / (1u64 << 30) as f64;
     let message = format!(
-        "needs about {:.1} GiB of memory for its {triangles} triangles and {} vertices (mesh and BVH), but only \
-         {:.1} GiB is available; refusing it",
-        gib(needed),
+        "needs about {} of memory for its {triangles} triangles and {} vertices (mesh and BVH), but only {} is \
+         available; refusing it",
+        shown_bytes(needed),
         vertices.positions,
-        gib(available)
+        shown_bytes(available)
     );
     Err(Error::io(name, io::Error::new(io::ErrorKind::OutOfMemory, message)))
 }
