@@ -1,7 +1,9 @@
-//! Hints about memory that change no value. Fresh memory: large buffers a render or a build writes
-//! once, whose first touch is a page fault per 4 KB page that zeroes it (measured at 1.3 GB/s in
-//! this project's VM, against 7 GB/s for writing memory already touched). Records read soon: a
-//! prefetch, so that other work runs while they come from memory.
+//! Large buffers and hints about memory. A render's buffers as large as its image are allocated
+//! zeroed and fallibly (memory that runs out is an error to report, not an abort). The hints change
+//! no value. Fresh memory: large buffers a render or a build writes once, whose first touch is a
+//! page fault per 4 KB page that zeroes it (measured at 1.3 GB/s in this project's VM, against 7
+//! GB/s for writing memory already touched). Records read soon: a prefetch, so that other work
+//! runs while they come from memory.
 
 /// Types for which all-zero bytes are a valid value: the float buffers a render allocates.
 ///
