@@ -6,7 +6,7 @@ use std::sync::{Arc, Mutex};
 use lumiere::render::aov::{Aov, render_aovs};
 use lumiere::render::film::Film;
 use lumiere::render::forecast::{NoiseForecast, shown_number};
-use lumiere::render::{Hooks, RenderStats, render_progressive};
+use lumiere::render::{Hooks, RenderStats, StopReason, render_progressive};
 use pyo3::prelude::*;
 use pyo3::types::{PyByteArray, PyDict};
 
@@ -83,6 +83,14 @@ pub fn render<'py>(
             };
             let hooks = Hooks { progress: &count, pass_done: &mut pass_done, cancel: &watch.cancel };
             let output = render_progressive(world, camera, options, film, RenderStats::default(), hooks)?;
+            // As the CLI: a budget spent before the first pass completed leaves no image (a black
+            // one came back, as if rendered). Interrupted, `watch::run` raises KeyboardInterrupt.
+            if output.film.samples == 0 && !matches!(output.stop, StopReason::Completed | StopReason::Interrupted) {
+                return Err(lumiere::Error::invalid(format!(
+                    "{} before the first pass completed, so there is no image: one pass takes longer than time=; give more time or fewer samples",
+                    output.stop.describe()
+                )));
+            }
             // Empty when cancelled: `watch::run` then raises, and nothing is returned.
             let buffers = if aovs.is_empty() {
                 Vec::new()
