@@ -6,6 +6,7 @@ use std::sync::{Arc, Mutex};
 use lumiere::render::aov::{Aov, render_aovs};
 use lumiere::render::film::Film;
 use lumiere::render::forecast::{NoiseForecast, shown_number};
+use lumiere::render::unlit::{Unlit, is_black, unlit};
 use lumiere::render::{Hooks, RenderStats, StopReason, render_progressive};
 use pyo3::prelude::*;
 use pyo3::types::{PyByteArray, PyDict};
@@ -65,6 +66,10 @@ pub fn render<'py>(
     let work = |watch: &Watch| {
         pool.install(|| {
             let film = Film::new(camera.width, camera.height)?;
+            let warn = |message: String| watch.warnings.lock().unwrap_or_else(|e| e.into_inner()).push(message);
+            if let Some(reason) = unlit(world, &options.technique) {
+                warn(unlit_message(&reason, options.technique.name()));
+            }
             let count = |n| {
                 watch.done.fetch_add(n, std::sync::atomic::Ordering::Relaxed);
             };
@@ -77,7 +82,7 @@ pub fn render<'py>(
                         shown_number(report.target),
                         report.describe()
                     );
-                    watch.warnings.lock().unwrap_or_else(|e| e.into_inner()).push(message);
+                    warn(message);
                 }
                 Ok(())
             };
@@ -90,6 +95,9 @@ pub fn render<'py>(
                     "{} before the first pass completed, so there is no image: one pass takes longer than time=; give more time or fewer samples",
                     output.stop.describe()
                 )));
+            }
+            if is_black(&output) {
+                warn("the image is black: no camera ray reached a lit surface; check the camera with mode='hits'".into());
             }
             // Empty when cancelled: `watch::run` then raises, and nothing is returned.
             let buffers = if aovs.is_empty() {
@@ -113,4 +121,21 @@ pub fn render<'py>(
     stats.set_item("threads", threads)?;
     stats.set_item("relative_error", output.film.relative_error())?;
     Ok((image, buffers, stats))
+}
+
+/// Why `mode` renders black for want of lights, in the package's words (the CLI says it with its
+/// flags).
+fn unlit_message(reason: &Unlit, mode: &str) -> String {
+    match reason {
+        Unlit::EmittersCannotEmit { materials } => format!(
+            "no triangle of the emitting material{} {} can emit (none uses it, or only triangles of zero area or of an area too large for f32), so mode={mode:?} renders black",
+            if materials.len() == 1 { "" } else { "s" },
+            materials.join(", ")
+        ),
+        Unlit::NoEmitter { materials, more } => format!(
+            "the scene has no emitters (no material with ke > 0), so mode={mode:?} renders black; make one emit with load(..., emission={{name: (r, g, b)}}) or a material's ke (materials: {}{}), or try mode='ao'",
+            materials.join(", "),
+            if *more > 0 { format!(" and {more} more") } else { String::new() }
+        ),
+    }
 }

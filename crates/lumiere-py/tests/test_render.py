@@ -418,3 +418,25 @@ def test_write_image_writes_the_cli_bytes(cli, tmp_path):
         image = lumiere.render(lumiere.builtin(), spp=2, size=(32, 24))
         lumiere.write_image(tmp_path / f"py.{extension}", image)
         assert (tmp_path / f"py.{extension}").read_bytes() == (tmp_path / f"cli.{extension}").read_bytes(), extension
+
+
+def test_a_render_that_comes_out_black_says_why(tmp_path):
+    # As the CLI says it, in the package's words: no emitter, emitters that cannot emit, and an
+    # image no camera ray lit; each a RuntimeWarning at the caller's line (they were silent).
+    unlit = tmp_path / "unlit.obj"
+    unlit.write_text("v -1 0 -1\nv 1 0 -1\nv 0 0 1\nf 1 3 2\n")
+    camera = lumiere.Camera.look_at((0, 1, 3), (0, 0, 0), size=(8, 8))
+    with pytest.warns(RuntimeWarning, match="the scene has no emitters") as caught:
+        lumiere.render(lumiere.load(str(unlit)), camera, spp=1)
+    assert all(w.filename == __file__ for w in caught), [(w.filename, str(w.message)) for w in caught]
+    flat = tmp_path / "flat.obj"
+    flat.write_text("v -1 0 -1\nv 1 0 -1\nv 0 0 1\nv 0 0 0\nf 1 3 2\nusemtl lamp\nf 4 4 4\n")
+    with pytest.warns(RuntimeWarning, match='no triangle of the emitting material "lamp" can emit'):
+        lumiere.render(lumiere.load(str(flat), emission={"lamp": (1, 1, 1)}), camera, spp=1)
+    away = lumiere.Camera.look_at((0, 1, 3.9), (0, 1, 10), size=(8, 6))
+    with pytest.warns(RuntimeWarning, match="the image is black: no camera ray reached a lit surface"):
+        lumiere.render(lumiere.builtin(), away, spp=1, mode="hits")
+    # A lit render says nothing of the kind.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        lumiere.render(lumiere.builtin(), spp=1, size=(8, 6), mode="hits")

@@ -26,6 +26,7 @@ pub mod forecast;
 mod options;
 mod pass;
 pub mod range;
+pub mod unlit;
 
 pub use options::RenderOptions;
 pub use range::render_pass_range;

@@ -8,6 +8,7 @@ use std::path::Path;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use lumiere::integrators::{AmbientOcclusion, Direct, Technique};
+use lumiere::render::unlit::{Unlit, is_black, unlit};
 use lumiere::render::{RenderOptions, RenderOutput};
 use lumiere::scene::camera::Camera;
 use lumiere::world::World;
@@ -112,36 +113,27 @@ fn samples_per_camera_sample(technique: &Technique) -> Option<u32> {
 /// Why an image may come out black, said before rendering: a technique that needs lights in a
 /// scene that has none.
 pub fn warn_if_unlit(world: &World, options: &RenderOptions) {
-    let needs_lights = matches!(options.technique, Technique::Shadows(_) | Technique::Direct(_) | Technique::Path(_));
-    if !needs_lights || !world.lights().is_empty() {
-        return;
+    let mode = options.technique.name();
+    match unlit(world, &options.technique) {
+        None => {}
+        Some(Unlit::EmittersCannotEmit { materials }) => output::warn(format_args!(
+            "no triangle of the emitting material{} {} can emit (none uses it, or only triangles of zero area or of an area too large for f32), so --mode {mode} renders black",
+            if materials.len() == 1 { "" } else { "s" },
+            materials.join(", ")
+        )),
+        Some(Unlit::NoEmitter { materials, more }) => {
+            let more = if more > 0 { format!(" and {more} more") } else { String::new() };
+            output::warn(format_args!(
+                "the scene has no emitters (no material with Ke > 0), so --mode {mode} renders black; make one emit with --emission NAME=r,g,b (materials: {}{more}) or try --mode ao",
+                materials.join(", ")
+            ));
+        }
     }
-    // Emitting materials whose triangles could not become lights: the advice to make one emit
-    // would be advice already followed.
-    let emitting: Vec<String> =
-        world.scene().materials.iter().filter(|m| m.ke.max_element() > 0.0).map(|m| format!("{:?}", m.name)).collect();
-    if !emitting.is_empty() {
-        output::warn(format_args!(
-            "no triangle of the emitting material{} {} can emit (none uses it, or only triangles of zero area or of an area too large for f32), so --mode {} renders black",
-            if emitting.len() == 1 { "" } else { "s" },
-            emitting.iter().take(5).cloned().collect::<Vec<_>>().join(", "),
-            options.technique.name()
-        ));
-        return;
-    }
-    let names: Vec<String> = world.scene().materials.iter().take(5).map(|m| format!("{:?}", m.name)).collect();
-    let more = world.scene().materials.len().saturating_sub(names.len());
-    let more = if more > 0 { format!(" and {more} more") } else { String::new() };
-    output::warn(format_args!(
-        "the scene has no emitters (no material with Ke > 0), so --mode {} renders black; make one emit with --emission NAME=r,g,b (materials: {}{more}) or try --mode ao",
-        options.technique.name(),
-        names.join(", ")
-    ));
 }
 
 /// Why an image came out black, said after rendering: no camera ray saw anything lit.
 pub fn warn_if_black(output: &RenderOutput) {
-    if output.film.samples > 0 && output.image.pixels.iter().all(|p| p.max_element() <= 0.0) {
+    if is_black(output) {
         output::warn("the image is black: no camera ray reached a lit surface; check the camera with --mode hits");
     }
 }
