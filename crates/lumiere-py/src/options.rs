@@ -90,9 +90,13 @@ impl PyOptions {
         };
         let seconds = |value: Option<f64>, what: &str| -> PyResult<Option<Duration>> {
             value
-                // As `--time`: any positive number of seconds, however small.
-                .map(|s| Duration::try_from_secs_f64(s).ok().filter(|_| s > 0.0))
-                .map(|d| d.ok_or_else(|| invalid(format!("{what} must be a positive number of seconds"))))
+                // As `--time`: any positive number of seconds, however small, short of what a
+                // `Duration` holds (about 585 billion years), which the CLI calls too long too.
+                .map(|s| match Duration::try_from_secs_f64(s) {
+                    Ok(d) if s > 0.0 => Ok(d),
+                    Err(_) if s > 0.0 => Err(invalid(format!("{what}={s} seconds is too long a duration"))),
+                    _ => Err(invalid(format!("{what} must be a positive number of seconds"))),
+                })
                 .transpose()
         };
         let time_budget = seconds(time, "time")?;

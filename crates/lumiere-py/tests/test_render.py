@@ -440,3 +440,25 @@ def test_a_render_that_comes_out_black_says_why(tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         lumiere.render(lumiere.builtin(), spp=1, size=(8, 6), mode="hits")
+
+
+def test_arguments_found_by_a_hostile_sweep(tmp_path):
+    vertices = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32)
+    # Complex numbers and strings of digits are not vertices (the imaginary part was dropped).
+    for wrong in (vertices.astype(complex), vertices.astype(str)):
+        with pytest.raises(lumiere.LumiereError, match="vertices must be an array of numbers"):
+            lumiere.Scene.from_arrays(wrong, [[0, 1, 2]])
+    # Values beyond float32 become infinities without numpy's warning from inside the package.
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        lumiere.write_image(str(tmp_path / "big.pfm"), np.full((2, 2, 3), 1e300))
+        with pytest.raises(lumiere.LumiereError):
+            lumiere.Scene.from_arrays(vertices.astype(np.float64) * 1e300, [[0, 1, 2]])
+    assert not caught, [(w.filename, str(w.message)) for w in caught]
+    # A budget too long for a duration is said to be one, not "not positive".
+    with pytest.raises(lumiere.LumiereError, match="too long a duration"):
+        lumiere.render(lumiere.builtin(), spp=None, size=(8, 6), time=1e300)
+    # No AOVs as None; a progress that cannot be called, refused before rendering.
+    assert lumiere.render(lumiere.builtin(), spp=1, size=(8, 6), aovs=None).shape == (6, 8, 3)
+    with pytest.raises(TypeError, match="progress must be callable"):
+        lumiere.render(lumiere.builtin(), spp=1, size=(8, 6), progress=3)

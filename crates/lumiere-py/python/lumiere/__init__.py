@@ -49,7 +49,10 @@ def write_image(path: str, image: "object", exposure: float = 0.0, tonemap: str 
     # None to NaN, and written.
     if values.dtype.kind not in "buif":
         raise LumiereError(f"image must hold numbers, got an array of {values.dtype}")
-    array = np.ascontiguousarray(values, dtype=np.float32)
+    # Values beyond float32 become infinities, as the CLI's would: numpy's overflow warning would
+    # point at this line, not the caller's.
+    with np.errstate(over="ignore"):
+        array = np.ascontiguousarray(values, dtype=np.float32)
     if array.ndim != 3 or array.shape[2] != 3:
         raise LumiereError(f"image must have shape (height, width, 3), got {array.shape}")
     height, width = array.shape[:2]

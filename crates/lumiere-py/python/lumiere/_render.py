@@ -117,6 +117,11 @@ def render_full(
     camera = _camera(scene, camera, size)
     if isinstance(aovs, str):
         aovs = (aovs,)
+    if aovs is None:
+        aovs = ()
+    # Checked now, not after the render's first pass: a callback that cannot be called.
+    if progress is not None and not callable(progress):
+        raise TypeError(f"progress must be callable as progress(done, total), got {type(progress).__name__}")
     aovs = tuple(_text(aov, f"aovs[{index}]") for index, aov in enumerate(aovs))
     # An EXR cannot hold a channel twice, and the CLI refuses it: so does this.
     twice = _first_repeat(aovs)

@@ -109,7 +109,15 @@ def _own_array(value: Any, dtype: Any, what: str) -> np.ndarray:
     the caller's buffer, which the caller may change after the scene is made (numpy's
     ``ascontiguousarray`` returns the very array when it already fits)."""
     try:
-        array = np.array(value, dtype=dtype, order="C", copy=True)
+        given = np.asarray(value)
+        # Real numbers only: strings of digits and complex numbers were converted (the imaginary
+        # part dropped, with numpy's warning pointing here), as write_image refuses them.
+        if given.dtype.kind not in "buif":
+            raise TypeError
+        # Values beyond the type become infinities, refused by name later, without numpy's
+        # overflow warning pointing at this line.
+        with np.errstate(over="ignore"):
+            array = np.array(given, dtype=dtype, order="C", copy=True)
     except (TypeError, ValueError, OverflowError):
         raise LumiereError(f"{what} must be an array of numbers") from None
     array.flags.writeable = False
