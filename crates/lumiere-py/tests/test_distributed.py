@@ -179,6 +179,12 @@ def test_bad_arguments_are_refused_before_connecting(tmp_path):
         distributed.render(lumiere.builtin(), spp=2, tasks=True, address="127.0.0.1:9")
     with pytest.raises(lumiere.LumiereError, match="checkpoint_every must be a finite number of seconds"):
         distributed.render(lumiere.builtin(), spp=2, checkpoint_every=float("nan"), address="127.0.0.1:9")
+    # An int beyond a float's range (math.isfinite raised OverflowError on it), and an address
+    # that is not text (it raised "argument of type 'int' is not iterable").
+    with pytest.raises(lumiere.LumiereError, match="checkpoint_every must be a finite number of seconds"):
+        distributed.render(lumiere.builtin(), spp=2, checkpoint_every=2**1100, address="127.0.0.1:9")
+    with pytest.raises(TypeError, match="address must be a string"):
+        distributed.render(lumiere.builtin(), spp=2, size=(8, 6), address=5)
     # A checkpoint that cannot be written is refused now, not after the render it would hold.
     with pytest.raises(lumiere.LumiereError, match="is a directory"):
         distributed.render(lumiere.builtin(), spp=2, checkpoint=tmp_path, address="127.0.0.1:9")

@@ -462,3 +462,6 @@ def test_arguments_found_by_a_hostile_sweep(tmp_path):
     assert lumiere.render(lumiere.builtin(), spp=1, size=(8, 6), aovs=None).shape == (6, 8, 3)
     with pytest.raises(TypeError, match="progress must be callable"):
         lumiere.render(lumiere.builtin(), spp=1, size=(8, 6), progress=3)
+    # No materials for triangles that need one: named for what it is.
+    with pytest.raises(lumiere.LumiereError, match="materials must name at least one material"):
+        lumiere.Scene.from_arrays(vertices, [[0, 1, 2]], materials=[])

@@ -184,6 +184,14 @@ class Scene:
         triangles = _own_array(triangles, np.uint32, "triangles")
         if isinstance(materials, (str, bytes)):
             raise LumiereError(f"materials must be a list of names or dicts, got {materials!r}")
+        if materials is not None:
+            try:
+                materials = list(materials)
+            except TypeError:
+                raise LumiereError(f"materials must be a list of names or dicts, got {materials!r}") from None
+        # Named for what it is, not as "material id 0 out of range": every triangle needs one.
+        if materials is not None and len(triangles) > 0 and len(materials) == 0:
+            raise LumiereError("materials must name at least one material (material_ids index it; 0 by default)")
         specs = []
         for index, material in enumerate(materials if materials is not None else ["default"]):
             if isinstance(material, str):

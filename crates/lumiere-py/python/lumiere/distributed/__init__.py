@@ -69,6 +69,8 @@ def connect(address: Optional[str] = "auto", timeout: float = 5.0) -> Any:
         ``ray start`` last started on this machine), or None to start a local Ray instance.
     :raises ClusterUnreachable: nothing answers at ``address`` (within ``timeout`` seconds).
     """
+    if address is not None and not isinstance(address, str):
+        raise TypeError(f"address must be a string ('host:port' or 'auto') or None, got {type(address).__name__}")
     ray = _ray()
     if ray.is_initialized():
         return ray
@@ -164,7 +166,9 @@ def render_full(
     tasks = None if tasks is None else _integer(tasks, "tasks", 1)
     threads_per_task = _integer(threads_per_task, "threads_per_task", 1)
     max_retries = _integer(max_retries, "max_retries", 0)
+    # An int too large for a float (2**1100) is not finite either: `math.isfinite` raised on it.
     if not (isinstance(checkpoint_every, (int, float)) and not isinstance(checkpoint_every, bool)
+            and (not isinstance(checkpoint_every, int) or abs(checkpoint_every) < 2**1023)
             and math.isfinite(checkpoint_every) and checkpoint_every >= 0):
         raise LumiereError(f"checkpoint_every must be a finite number of seconds, at least 0, got {checkpoint_every!r}")
     # Refused now, not once the render is done and the checkpoint cannot hold it.
