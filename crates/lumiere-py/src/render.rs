@@ -4,7 +4,7 @@
 use std::sync::{Arc, Mutex};
 
 use lumiere::render::aov::{Aov, render_aovs};
-use lumiere::render::film::Film;
+use lumiere::render::film::{Film, check_memory};
 use lumiere::render::forecast::{NoiseForecast, shown_number};
 use lumiere::render::unlit::{Unlit, is_black, unlit};
 use lumiere::render::{Hooks, RenderStats, StopReason, render_progressive};
@@ -59,6 +59,11 @@ pub fn render<'py>(
 ) -> PyResult<Rendered<'py>> {
     let aovs = aovs.iter().map(|name| Aov::parse(name)).collect::<lumiere::Result<Vec<_>>>().or_py()?;
     let (world, camera, options) = (&*scene.world, &camera.camera, &options.options);
+    // As the CLI's check before rendering: each AOV's buffer and its bytes for numpy, and the
+    // image's bytes, beside the film (a huge image's AOVs aborted the interpreter once rendered).
+    if !aovs.is_empty() {
+        check_memory(camera.width, camera.height, aovs.len() as u64 * 24 + 12, " with its AOVs").or_py()?;
+    }
     let pool = pool(threads)?;
     let threads = pool.current_num_threads();
     let pixels = u64::from(camera.width) * u64::from(camera.height);

@@ -465,3 +465,22 @@ def test_arguments_found_by_a_hostile_sweep(tmp_path):
     # No materials for triangles that need one: named for what it is.
     with pytest.raises(lumiere.LumiereError, match="materials must name at least one material"):
         lumiere.Scene.from_arrays(vertices, [[0, 1, 2]], materials=[])
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="an address-space limit, as the CLI's tests use")
+def test_aovs_that_do_not_fit_beside_the_film_are_refused_before_rendering():
+    # Under a 2 GiB address-space limit a 5000x4000 film fits alone, but not with three AOVs: one
+    # line naming them, before rendering, not the allocator's abort of the interpreter after it.
+    script = textwrap.dedent(
+        """
+        import resource, lumiere
+        resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30))
+        try:
+            lumiere.render(lumiere.builtin(), spp=1, size=(5000, 4000), mode="hits", aovs=("albedo", "normal", "depth"))
+        except lumiere.LumiereError as error:
+            print(error)
+        """
+    )
+    child = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert child.returncode == 0, child.stderr
+    assert "image size 5000x4000 with its AOVs needs" in child.stdout, (child.stdout, child.stderr)
