@@ -234,29 +234,33 @@ fn killed_and_resumed_renders_give_identical_bytes() {
     assert!(total_kills >= 6, "only {total_kills} kills landed mid-render");
 }
 
+/// Renders AO for its 2 s budget with `outputs` (which write into `dir/folder`), takes that folder
+/// away (renamed to `<folder>-gone`: atomic, so it cannot race a file being written there) as soon
+/// as `watched` appears in it, as a full disk would refuse the next writes; returns the run and
+/// when it started.
+fn render_losing_a_folder(dir: &TempDir, folder: &str, watched: &str, outputs: &[&str]) -> (Output, Instant) {
+    fs::create_dir(dir.path(folder)).unwrap();
+    let args = ["render", "--mode", "ao", "--samples", "4", "--size", "32x24", "--spp", "1000000", "--time", "2s"];
+    let start = Instant::now();
+    let child =
+        Command::new(env!("CARGO_BIN_EXE_lumiere")).args(args).args(outputs).stderr(Stdio::piped()).spawn().unwrap();
+    let watched = dir.path(&format!("{folder}/{watched}"));
+    while fs::metadata(&watched).is_err() {
+        assert!(start.elapsed() < Duration::from_secs(20), "{} was never written", watched.display());
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    fs::rename(dir.path(folder), dir.path(&format!("{folder}-gone"))).unwrap();
+    (child.wait_with_output().unwrap(), start)
+}
+
 /// A checkpoint that cannot be written mid-render (its folder gone, as a full disk would refuse
 /// it) costs a warning, once, not the render: the passes go on, the image is written, and the
 /// final checkpoint's failure, after it, makes the exit code.
 #[test]
 fn a_checkpoint_that_cannot_be_written_does_not_lose_the_image() {
     let dir = TempDir::new("checkpoint-fails");
-    fs::create_dir(dir.path("ck")).unwrap();
     let (checkpoint, out) = (dir.arg("ck/c.ckpt"), dir.arg("o.png"));
-    let args = ["render", "--mode", "ao", "--samples", "4", "--size", "32x24", "--spp", "1000000", "--time", "2s"];
-    let child = Command::new(env!("CARGO_BIN_EXE_lumiere"))
-        .args(args)
-        .args(["--checkpoint", &checkpoint, "-o", &out])
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let start = Instant::now();
-    while fs::metadata(&checkpoint).is_err() {
-        assert!(start.elapsed() < Duration::from_secs(20), "no checkpoint was written");
-        std::thread::sleep(Duration::from_millis(2));
-    }
-    // A rename, not a removal: it is atomic, so it cannot race a checkpoint being written there.
-    fs::rename(dir.path("ck"), dir.path("ck-gone")).unwrap();
-    let run = child.wait_with_output().unwrap();
+    let (run, _) = render_losing_a_folder(&dir, "ck", "c.ckpt", &["--checkpoint", &checkpoint, "-o", &out]);
     let text = stderr(&run);
     assert_eq!(run.status.code(), Some(2), "{text}");
     assert_eq!(text.matches("the checkpoint was not updated").count(), 1, "one warning: {text}");
@@ -270,22 +274,8 @@ fn a_checkpoint_that_cannot_be_written_does_not_lose_the_image() {
 #[test]
 fn a_preview_that_cannot_be_written_does_not_end_the_render() {
     let dir = TempDir::new("preview-fails");
-    fs::create_dir(dir.path("out")).unwrap();
     let out = dir.arg("out/o.png");
-    let args = ["render", "--mode", "ao", "--samples", "4", "--size", "32x24", "--spp", "1000000", "--time", "2s"];
-    let start = Instant::now();
-    let child = Command::new(env!("CARGO_BIN_EXE_lumiere"))
-        .args(args)
-        .args(["--preview-every", "0.01", "-o", &out])
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    while fs::metadata(&out).is_err() {
-        assert!(start.elapsed() < Duration::from_secs(20), "no preview was written");
-        std::thread::sleep(Duration::from_millis(2));
-    }
-    fs::rename(dir.path("out"), dir.path("out-gone")).unwrap();
-    let run = child.wait_with_output().unwrap();
+    let (run, start) = render_losing_a_folder(&dir, "out", "o.png", &["--preview-every", "0.01", "-o", &out]);
     let text = stderr(&run);
     assert_eq!(run.status.code(), Some(2), "{text}");
     assert_eq!(text.matches("the preview was not written").count(), 1, "one warning: {text}");

@@ -14,8 +14,7 @@ use std::time::Duration;
 
 use crate::error::{Error, Result};
 use crate::render::RenderStats;
-use crate::render::film::Film;
-use crate::render::pass::out_of_memory;
+use crate::render::film::{Film, out_of_memory};
 use crate::util::hash::hash_bytes;
 use crate::util::write::write_atomically;
 
@@ -160,6 +159,8 @@ impl Reader<'_> {
 /// (`AmbientOcclusion(AmbientOcclusion { samples: 2, distance: inf })`) as its `--mode` and
 /// settings (`--mode ao (samples: 2, distance: inf)`), the sampler's as its `--sampler` name.
 /// Anything else, or a description from another version that does not parse, stays as written.
+/// Only the message is reworded: the description itself keeps the records' Debug text, since it
+/// is what a checkpoint's options fingerprint hashes, and checkpoints already written must resume.
 fn readable(key: &str, value: &str) -> String {
     match key {
         "technique" => {

@@ -11,7 +11,6 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::pass::out_of_memory;
 use crate::error::{Error, Result, shown_bytes};
 use crate::util::memory::try_zeroed_vec;
 
@@ -282,6 +281,15 @@ fn add_sample(s: &mut [f64; 3], sq: &mut f64, value: [f32; 3]) -> bool {
     let y = luminance(v);
     *sq += y * y;
     valid
+}
+
+/// The error of a render's buffer that the memory left cannot hold (more than the check before
+/// rendering foresaw: other processes took memory meanwhile, or the scene's own did not count).
+pub(crate) fn out_of_memory(width: u32, height: u32, bytes: usize, what: &str) -> Error {
+    Error::invalid(format!(
+        "image size {width}x{height}: out of memory for {what} ({}); render a smaller image, or free memory",
+        shown_bytes(bytes as u64)
+    ))
 }
 
 /// Refuses a render of `width` x `height` whose buffers cannot fit in the memory left, naming

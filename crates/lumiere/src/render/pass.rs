@@ -8,8 +8,9 @@ use glam::Vec2;
 use rayon::prelude::*;
 
 use super::StopReason;
+use super::film::out_of_memory;
 use crate::accel::OriginBatch;
-use crate::error::{Error, Result, shown_bytes};
+use crate::error::Result;
 use crate::integrators::{CameraPacket, Integrator, PACKET, SampleContext};
 use crate::math::Ray;
 use crate::sampler::{SampleStream, Sampler};
@@ -44,15 +45,6 @@ pub(super) fn pass_buffer(width: u32, height: u32) -> Result<Vec<[f32; 3]>> {
     // Its 2,300 4 KB pages, zeroed at their first touch, were a sixth of a hard-shadow render.
     ask_for_huge_pages(buffer.as_ptr(), buffer.len());
     Ok(buffer)
-}
-
-/// The error of a render's buffer that the memory left cannot hold (more than the check before
-/// rendering foresaw: other processes took memory meanwhile, or the scene's own did not count).
-pub(crate) fn out_of_memory(width: u32, height: u32, bytes: usize, what: &str) -> Error {
-    Error::invalid(format!(
-        "image size {width}x{height}: out of memory for {what} ({}); render a smaller image, or free memory",
-        shown_bytes(bytes as u64)
-    ))
 }
 
 /// The camera ray of sample `sample` of pixel `(x, y)`, and that sample's random numbers with the
