@@ -479,6 +479,32 @@ fn faces_need_three_valid_corners() {
     assert_error(&with("usemtl\n"), 5, "usemtl");
 }
 
+/// A trailing backslash continues a statement on the next line (the OBJ specification), in LF and
+/// CRLF files, at the end of the file and across the chunks that are parsed in parallel; the
+/// lines after a joined statement keep their numbers in messages, and a joined statement is
+/// reported at its first line. A comment ending with a backslash continues nothing.
+#[test]
+fn trailing_backslashes_continue_statements() {
+    let expected = parse("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3 4\n");
+    for text in [
+        "v 0 0 0\nv 1 0 \\\n0\nv 0 1 0\nv 1 1 0\nf 1 2 \\\n  3 \\\n 4\n",
+        "v 0 0 0\r\nv 1 0 \\\r\n0\r\nv 0 1 0\r\nv 1 1 0\r\nf 1 2\\\r\n3 4",
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3 4 \\\n",
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3 \\\n4 \\",
+    ] {
+        for chunk_bytes in [usize::MAX, 1, 9] {
+            let scene = parse_obj_with_chunk_size(text.as_bytes(), Path::new("test.obj"), &mtl_files(&[]), chunk_bytes)
+                .unwrap_or_else(|error| panic!("{text:?} in chunks of {chunk_bytes}: {error}"));
+            assert_eq!(scene.mesh.positions, expected.mesh.positions, "{text:?}");
+            assert_eq!(scene.mesh.indices, expected.mesh.indices, "{text:?}");
+        }
+    }
+    assert_error(format!("{SQUARE}f 1 \\\n2 \\\n3\nv x 0 0\n").as_bytes(), 8, "\"x\"");
+    assert_error(b"v 0 0 0\nv 0 \\\n0 \\\nq\n", 2, "\"q\"");
+    let commented = parse("# exported to C:\\models\\\nv 0 0 0\nv 1 0 0\nv 0 1 0 # C:\\\nf 1 2 3\n");
+    assert_eq!(commented.mesh.indices, vec![[0, 1, 2]]);
+}
+
 #[test]
 fn huge_indices_do_not_overflow() {
     for index in [

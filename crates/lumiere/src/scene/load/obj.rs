@@ -6,11 +6,14 @@
 //! line number and the number of vertices defined before it, so the second pass resolves relative
 //! indices and reports errors exactly as a sequential parser would (see `obj/chunk.rs`).
 //!
-//! Not supported: line continuations (a trailing `\`), free-form geometry, polylines and points
-//! (each skipped keyword is warned about once, with its count), and lone `\r` line ends (refused
-//! with an error, as an MTL file with them is warned about and not read).
+//! Line continuations (a trailing `\`) are joined before the file is cut (`obj/continued.rs`).
+//!
+//! Not supported: free-form geometry, polylines and points (each skipped keyword is warned about
+//! once, with its count), and lone `\r` line ends (refused with an error, as an MTL file with them
+//! is warned about and not read).
 
 mod chunk;
+mod continued;
 mod materials;
 mod mtl;
 mod skipped;
@@ -160,6 +163,11 @@ fn parse_obj_within(
     if text::has_lone_carriage_returns(bytes) {
         return Err(Error::parse(name, 1, text::LONE_CARRIAGE_RETURNS));
     }
+    let joined = continued::join_continued_lines(bytes).map_err(|_| {
+        let message = format!("joining its continued lines needs {} more of memory", shown_bytes(bytes.len() as u64));
+        Error::io(name, io::Error::new(io::ErrorKind::OutOfMemory, message))
+    })?;
+    let bytes = joined.as_deref().unwrap_or(bytes);
     let chunks = split_lines(bytes, chunk_bytes.max(1));
     let counts: Vec<ChunkCounts> = chunks.par_iter().map(|chunk| ChunkCounts::of(chunk)).collect();
     let (starts, totals) = chunk_starts(&counts);
