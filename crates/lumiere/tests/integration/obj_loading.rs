@@ -503,6 +503,12 @@ fn trailing_backslashes_continue_statements() {
     assert_error(b"v 0 0 0\nv 0 \\\n0 \\\nq\n", 2, "\"q\"");
     let commented = parse("# exported to C:\\models\\\nv 0 0 0\nv 1 0 0\nv 0 1 0 # C:\\\nf 1 2 3\n");
     assert_eq!(commented.mesh.indices, vec![[0, 1, 2]]);
+    // In an MTL file too; a warning names the line it was on, after joined statements.
+    let mtl = "newmtl red\nKd 1 \\\r\n  0 0\nKs \\\n0.5\nNs x\n";
+    let scene = parse_with(&format!("mtllib red.mtl\n{SQUARE}usemtl red\nf 1 2 3\n"), &[("red.mtl", mtl)]);
+    assert_eq!((scene.materials[0].kd, scene.materials[0].ks), (Vec3::X, Vec3::splat(0.5)));
+    assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
+    assert!(scene.warnings[0].starts_with("mem/red.mtl:6: "), "{:?}", scene.warnings);
 }
 
 #[test]

@@ -1,8 +1,8 @@
 //! Line continuations: a statement whose line ends with a backslash goes on on the next line (the
-//! OBJ specification's `\`, which some exporters use to wrap long `f` lines).
+//! OBJ specification's `\`, which some exporters use to wrap long `f` lines), in OBJ and MTL files.
 //!
-//! The continued lines are joined before the file is cut into chunks, so that no chunk starts
-//! inside a statement. The text keeps its length and its number of lines: a continuation's
+//! An OBJ file's continued lines are joined before it is cut into chunks, so that no chunk
+//! starts inside a statement. The text keeps its length and its number of lines: a continuation's
 //! backslash (and the `\r` of a CRLF line) becomes a space, and the newline it swallowed moves to
 //! the end of the statement, as a blank line. So every line after a joined statement keeps its
 //! number in messages, and a joined statement is reported at its first line.
