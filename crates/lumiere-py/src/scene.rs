@@ -18,6 +18,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::errors::{OrPyErr, invalid};
+use crate::watch;
 
 /// A scene ready to render (its BVH and lights built).
 #[pyclass(module = "lumiere._lumiere", name = "NativeScene", frozen)]
@@ -39,7 +40,8 @@ pub struct PyScene {
 type MaterialSpec = (String, [f32; 3], [f32; 3]);
 
 impl PyScene {
-    /// Applies `emission`, builds the world; the GIL is released while building.
+    /// Applies `emission`, builds the world; the GIL is released while building, and Ctrl-C
+    /// returns at once (the build ends in the background).
     fn finish(
         py: Python<'_>,
         mut scene: Scene,
@@ -52,7 +54,7 @@ impl PyScene {
         }
         let fingerprint = scene_fingerprint(&scene);
         let start = Instant::now();
-        let world = py.detach(|| World::new(scene, BuildPreset::Default));
+        let world = watch::abandonable(py, move || World::new(scene, BuildPreset::Default))?;
         let build_seconds = start.elapsed().as_secs_f64();
         Ok(PyScene { world: Arc::new(world), builtin, fingerprint, load_seconds: load, build_seconds })
     }
@@ -61,17 +63,17 @@ impl PyScene {
 #[pymethods]
 impl PyScene {
     /// Loads an OBJ (or .obj.gz) file with its MTL, or the built-in scene when `path` is None.
+    /// Ctrl-C returns at once, as during the build (the load ends in the background, unused).
     #[staticmethod]
     #[pyo3(signature = (path, emission))]
     fn load(py: Python<'_>, path: Option<PathBuf>, emission: Vec<(String, [f32; 3])>) -> PyResult<Self> {
         let start = Instant::now();
         let builtin = path.is_none();
-        let scene = py
-            .detach(|| match &path {
-                Some(path) => Scene::load(path),
-                None => Scene::builtin(),
-            })
-            .or_py()?;
+        let scene = watch::abandonable(py, move || match &path {
+            Some(path) => Scene::load(path),
+            None => Scene::builtin(),
+        })?
+        .or_py()?;
         PyScene::finish(py, scene, emission, builtin, start.elapsed().as_secs_f64())
     }
 

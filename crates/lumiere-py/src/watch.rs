@@ -3,14 +3,16 @@
 //! signals (Ctrl-C raises `KeyboardInterrupt`, as Python code would), to call the progress
 //! callback and to issue the warnings the work left (`RuntimeWarning`). A signal or an exception
 //! from the callback or a warning (under a filter that makes it one) sets the cancel flag, which
-//! the library polls inside passes, and is raised once the work has stopped.
+//! the library polls inside passes, and is raised once the work has stopped ([`run`]). Work the
+//! library cannot stop (a load, a BVH build) is left to finish in the background ([`abandonable`]).
 
 use std::ffi::CString;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::mpsc::{self, RecvTimeoutError};
 use std::sync::{Condvar, Mutex};
 use std::time::Duration;
 
-use pyo3::exceptions::PyRuntimeWarning;
+use pyo3::exceptions::{PyOSError, PyRuntimeWarning};
 use pyo3::prelude::*;
 
 use crate::errors::to_py;
@@ -76,6 +78,38 @@ pub fn run<T: Send>(
     warn(py, &watch.warnings, stacklevel)?;
     report(progress, &watch.done, total, &mut reported)?;
     Ok(value)
+}
+
+/// Runs `work`, which the library cannot stop part-way (loading a scene, building its BVH), on a
+/// thread of its own while the calling thread sleeps without the GIL, waking every few
+/// milliseconds to check for signals: Ctrl-C raises `KeyboardInterrupt` at once, as it would in
+/// Python code, and the work runs to its end in the background, where its result is dropped.
+pub fn abandonable<T: Send + 'static>(py: Python<'_>, work: impl FnOnce() -> T + Send + 'static) -> PyResult<T> {
+    let (send, mut receive) = mpsc::sync_channel(1);
+    let worker = std::thread::Builder::new()
+        .name("lumiere-work".into())
+        .spawn(move || {
+            // The receiver is gone once the caller was interrupted: the result is dropped here.
+            let _ = send.send(work());
+        })
+        .map_err(|e| PyOSError::new_err(format!("cannot start a thread for the work: {e}")))?;
+    loop {
+        // The receiver goes into the GIL-free wait and comes back out: it cannot be shared.
+        let (back, received) = py.detach(move || {
+            let received = receive.recv_timeout(POLL);
+            (receive, received)
+        });
+        receive = back;
+        match received {
+            Ok(value) => return Ok(value),
+            Err(RecvTimeoutError::Timeout) => py.check_signals()?,
+            // The work panicked before sending anything: the panic goes on here.
+            Err(RecvTimeoutError::Disconnected) => match worker.join() {
+                Err(panic) => std::panic::resume_unwind(panic),
+                Ok(()) => unreachable!("the worker sends its result before it ends"),
+            },
+        }
+    }
 }
 
 /// Issues the warnings the work left, as `RuntimeWarning`s `stacklevel` frames up; an error where

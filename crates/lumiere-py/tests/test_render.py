@@ -412,6 +412,42 @@ def test_ctrl_c_stops_the_render_and_raises_keyboard_interrupt(tmp_path):
         child.kill()
 
 
+def test_ctrl_c_while_a_scene_builds_raises_keyboard_interrupt_at_once():
+    # A BVH build cannot stop part-way: it ends in the background, unused, while Python goes on.
+    # Three million triangles on one thread take seconds to build; the interrupt must not wait.
+    script = textwrap.dedent(
+        """
+        import signal, sys, numpy as np, lumiere
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+        n = 3_000_000
+        rng = np.random.default_rng(1)
+        centres = rng.random((n, 1, 3), dtype=np.float32) * 100
+        vertices = (centres + rng.random((n, 3, 3), dtype=np.float32)).reshape(-1, 3)
+        triangles = np.arange(3 * n, dtype=np.uint32).reshape(n, 3)
+        print("building", flush=True)
+        try:
+            lumiere.Scene.from_arrays(vertices, triangles)
+            print("built", flush=True)
+        except KeyboardInterrupt:
+            print("KeyboardInterrupt", flush=True)
+            sys.exit(7)
+        """
+    )
+    env = dict(os.environ, RAYON_NUM_THREADS="1")
+    child = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True, env=env)
+    try:
+        assert child.stdout.readline().strip() == "building"
+        time.sleep(0.5)
+        sent = time.perf_counter()
+        child.send_signal(signal.SIGINT)
+        assert child.stdout.readline().strip() == "KeyboardInterrupt"
+        waited = time.perf_counter() - sent
+        assert child.wait(timeout=20) == 7
+        assert waited < 1.5, f"the interrupt waited {waited:.2f} s for the build"
+    finally:
+        child.kill()
+
+
 def test_write_image_writes_the_cli_bytes(cli, tmp_path):
     for extension in ("pfm", "png", "exr"):
         cli("render", "--size", "32x24", "--spp", "2", "-o", tmp_path / f"cli.{extension}")
