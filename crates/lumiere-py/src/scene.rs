@@ -17,7 +17,7 @@ use lumiere::world::World;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::errors::{OrPyErr, invalid};
+use crate::errors::OrPyErr;
 use crate::watch;
 
 /// A scene ready to render (its BVH and lights built).
@@ -40,23 +40,28 @@ pub struct PyScene {
 type MaterialSpec = (String, [f32; 3], [f32; 3]);
 
 impl PyScene {
-    /// Applies `emission`, builds the world; the GIL is released while building, and Ctrl-C
-    /// returns at once (the build ends in the background).
+    /// Applies `emission` and builds the world, away from the GIL: Ctrl-C returns at once, and
+    /// the build ends in the background ([`watch::abandonable`]).
     fn finish(
         py: Python<'_>,
-        mut scene: Scene,
+        scene: impl FnOnce() -> lumiere::Result<Scene> + Send + 'static,
         emission: Vec<(String, [f32; 3])>,
         builtin: bool,
-        load: f64,
     ) -> PyResult<Self> {
-        for (name, ke) in emission {
-            scene.set_emission(&name, Vec3::from(ke)).or_py()?;
-        }
-        let fingerprint = scene_fingerprint(&scene);
         let start = Instant::now();
-        let world = watch::abandonable(py, move || World::new(scene, BuildPreset::Default))?;
-        let build_seconds = start.elapsed().as_secs_f64();
-        Ok(PyScene { world: Arc::new(world), builtin, fingerprint, load_seconds: load, build_seconds })
+        let (world, fingerprint, load_seconds, build_seconds) = watch::abandonable(py, move || {
+            let mut scene = scene()?;
+            for (name, ke) in emission {
+                scene.set_emission(&name, Vec3::from(ke))?;
+            }
+            let load_seconds = start.elapsed().as_secs_f64();
+            let fingerprint = scene_fingerprint(&scene);
+            let build = Instant::now();
+            let world = World::new(scene, BuildPreset::Default);
+            Ok((world, fingerprint, load_seconds, build.elapsed().as_secs_f64()))
+        })?
+        .or_py()?;
+        Ok(PyScene { world: Arc::new(world), builtin, fingerprint, load_seconds, build_seconds })
     }
 }
 
@@ -67,14 +72,12 @@ impl PyScene {
     #[staticmethod]
     #[pyo3(signature = (path, emission))]
     fn load(py: Python<'_>, path: Option<PathBuf>, emission: Vec<(String, [f32; 3])>) -> PyResult<Self> {
-        let start = Instant::now();
         let builtin = path.is_none();
-        let scene = watch::abandonable(py, move || match &path {
+        let scene = move || match &path {
             Some(path) => Scene::load(path),
             None => Scene::builtin(),
-        })?
-        .or_py()?;
-        PyScene::finish(py, scene, emission, builtin, start.elapsed().as_secs_f64())
+        };
+        PyScene::finish(py, scene, emission, builtin)
     }
 
     /// A scene from float32 positions (x, y, z per vertex), uint32 corner indices (three per
@@ -91,37 +94,11 @@ impl PyScene {
         materials: Vec<MaterialSpec>,
         normals: Option<&[u8]>,
     ) -> PyResult<Self> {
-        let start = Instant::now();
-        let floats =
-            |b: &[u8]| b.chunks_exact(4).map(|c| f32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect::<Vec<_>>();
-        let ints =
-            |b: &[u8]| b.chunks_exact(4).map(|c| u32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect::<Vec<_>>();
-        let vec3s = |v: Vec<f32>| v.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect::<Vec<_>>();
-        let positions = vec3s(floats(positions));
-        if let Some(bad) = positions.iter().position(|p| !p.is_finite()) {
-            return Err(invalid(format!("{name}: vertex {bad} is not finite")));
-        }
-        let indices: Vec<[u32; 3]> = ints(indices).chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
-        let normals = normals.map(|n| vec3s(floats(n))).unwrap_or_default();
-        if !normals.is_empty() && normals.len() != positions.len() {
-            return Err(invalid(format!("{name}: {} normals for {} vertices", normals.len(), positions.len())));
-        }
-        let normal_indices = if normals.is_empty() { Vec::new() } else { indices.clone() };
-        let mesh = TriangleMesh {
-            material_ids: ints(material_ids),
-            positions,
-            indices,
-            normals,
-            normal_indices,
-            texcoords: Vec::<Vec2>::new(),
-            texcoord_indices: Vec::new(),
-        };
-        let materials = materials
-            .into_iter()
-            .map(|(name, kd, ke)| Material { kd: Vec3::from(kd), ke: Vec3::from(ke), ..Material::default_grey(&name) })
-            .collect();
-        let scene = Scene::from_parts(name, mesh, materials, Vec::new()).or_py()?;
-        PyScene::finish(py, scene, Vec::new(), false, start.elapsed().as_secs_f64())
+        // Copied while the GIL is held (the buffers are Python's), converted away from it.
+        let (positions, indices, material_ids) = (positions.to_vec(), indices.to_vec(), material_ids.to_vec());
+        let normals = normals.map(<[u8]>::to_vec);
+        let scene = move || scene_from_arrays(name, &positions, &indices, &material_ids, materials, normals.as_deref());
+        PyScene::finish(py, scene, Vec::new(), false)
     }
 
     #[getter]
@@ -204,4 +181,46 @@ fn placement(py: Python<'_>, transform: UvTransform) -> PyResult<Option<Bound<'_
     entry.set_item("scale", transform.scale.to_array())?;
     entry.set_item("offset", transform.offset.to_array())?;
     Ok(Some(entry))
+}
+
+/// The scene of [`PyScene::from_arrays`]'s buffers (native-endian float32 and uint32 values).
+fn scene_from_arrays(
+    name: String,
+    positions: &[u8],
+    indices: &[u8],
+    material_ids: &[u8],
+    materials: Vec<MaterialSpec>,
+    normals: Option<&[u8]>,
+) -> lumiere::Result<Scene> {
+    let floats = |b: &[u8]| b.chunks_exact(4).map(|c| f32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect::<Vec<_>>();
+    let ints = |b: &[u8]| b.chunks_exact(4).map(|c| u32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect::<Vec<_>>();
+    let vec3s = |v: Vec<f32>| v.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect::<Vec<_>>();
+    let positions = vec3s(floats(positions));
+    if let Some(bad) = positions.iter().position(|p| !p.is_finite()) {
+        return Err(lumiere::Error::invalid(format!("{name}: vertex {bad} is not finite")));
+    }
+    let indices: Vec<[u32; 3]> = ints(indices).chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+    let normals = normals.map(|n| vec3s(floats(n))).unwrap_or_default();
+    if !normals.is_empty() && normals.len() != positions.len() {
+        return Err(lumiere::Error::invalid(format!(
+            "{name}: {} normals for {} vertices",
+            normals.len(),
+            positions.len()
+        )));
+    }
+    let normal_indices = if normals.is_empty() { Vec::new() } else { indices.clone() };
+    let mesh = TriangleMesh {
+        material_ids: ints(material_ids),
+        positions,
+        indices,
+        normals,
+        normal_indices,
+        texcoords: Vec::<Vec2>::new(),
+        texcoord_indices: Vec::new(),
+    };
+    let materials = materials
+        .into_iter()
+        .map(|(name, kd, ke)| Material { kd: Vec3::from(kd), ke: Vec3::from(ke), ..Material::default_grey(&name) })
+        .collect();
+    Scene::from_parts(name, mesh, materials, Vec::new())
 }

@@ -10,6 +10,7 @@ use std::ffi::CString;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc::{self, RecvTimeoutError};
 use std::sync::{Condvar, Mutex};
+use std::thread::JoinHandle;
 use std::time::Duration;
 
 use pyo3::exceptions::{PyOSError, PyRuntimeWarning};
@@ -80,11 +81,17 @@ pub fn run<T: Send>(
     Ok(value)
 }
 
+/// Work that a Ctrl-C left running in the background (see [`abandonable`]).
+static LEFT_RUNNING: Mutex<Vec<JoinHandle<()>>> = Mutex::new(Vec::new());
+
 /// Runs `work`, which the library cannot stop part-way (loading a scene, building its BVH), on a
 /// thread of its own while the calling thread sleeps without the GIL, waking every few
 /// milliseconds to check for signals: Ctrl-C raises `KeyboardInterrupt` at once, as it would in
 /// Python code, and the work runs to its end in the background, where its result is dropped.
+/// Work left running so is waited for (still answering Ctrl-C) before the next starts, so that
+/// interrupting a load again and again never piles up scenes in memory.
 pub fn abandonable<T: Send + 'static>(py: Python<'_>, work: impl FnOnce() -> T + Send + 'static) -> PyResult<T> {
+    wait_for_work_left_running(py)?;
     let (send, mut receive) = mpsc::sync_channel(1);
     let worker = std::thread::Builder::new()
         .name("lumiere-work".into())
@@ -102,13 +109,32 @@ pub fn abandonable<T: Send + 'static>(py: Python<'_>, work: impl FnOnce() -> T +
         receive = back;
         match received {
             Ok(value) => return Ok(value),
-            Err(RecvTimeoutError::Timeout) => py.check_signals()?,
+            Err(RecvTimeoutError::Timeout) => {
+                if let Err(interrupt) = py.check_signals() {
+                    LEFT_RUNNING.lock().unwrap_or_else(|e| e.into_inner()).push(worker);
+                    return Err(interrupt);
+                }
+            }
             // The work panicked before sending anything: the panic goes on here.
             Err(RecvTimeoutError::Disconnected) => match worker.join() {
                 Err(panic) => std::panic::resume_unwind(panic),
                 Ok(()) => unreachable!("the worker sends its result before it ends"),
             },
         }
+    }
+}
+
+/// Returns once no work a Ctrl-C left running is still running, or with the next signal.
+fn wait_for_work_left_running(py: Python<'_>) -> PyResult<()> {
+    loop {
+        let mut left = LEFT_RUNNING.lock().unwrap_or_else(|e| e.into_inner());
+        left.retain(|worker| !worker.is_finished());
+        if left.is_empty() {
+            return Ok(());
+        }
+        drop(left);
+        py.detach(|| std::thread::sleep(POLL));
+        py.check_signals()?;
     }
 }
 

@@ -413,39 +413,64 @@ def test_ctrl_c_stops_the_render_and_raises_keyboard_interrupt(tmp_path):
 
 
 def test_ctrl_c_while_a_scene_builds_raises_keyboard_interrupt_at_once():
-    # A BVH build cannot stop part-way: it ends in the background, unused, while Python goes on.
-    # Three million triangles on one thread take seconds to build; the interrupt must not wait.
+    # A BVH build cannot stop part-way: it ends in the background, unused, while Python goes on;
+    # the next load waits for it, so that interrupted builds never pile up. Three million
+    # triangles on one thread take seconds to build: the interrupt must not wait for them, and
+    # the load after it must.
     script = textwrap.dedent(
         """
-        import signal, sys, numpy as np, lumiere
+        import signal, sys, time, numpy as np, lumiere
         signal.signal(signal.SIGINT, signal.default_int_handler)
         n = 3_000_000
         rng = np.random.default_rng(1)
         centres = rng.random((n, 1, 3), dtype=np.float32) * 100
         vertices = (centres + rng.random((n, 3, 3), dtype=np.float32)).reshape(-1, 3)
         triangles = np.arange(3 * n, dtype=np.uint32).reshape(n, 3)
-        print("building", flush=True)
         try:
             lumiere.Scene.from_arrays(vertices, triangles)
             print("built", flush=True)
         except KeyboardInterrupt:
             print("KeyboardInterrupt", flush=True)
-            sys.exit(7)
+        start = time.perf_counter()
+        lumiere.builtin()
+        print(time.perf_counter() - start, flush=True)
         """
     )
     env = dict(os.environ, RAYON_NUM_THREADS="1")
     child = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True, env=env)
     try:
-        assert child.stdout.readline().strip() == "building"
-        time.sleep(0.5)
+        # Interrupted once the build's thread runs (not while numpy makes the arrays).
+        threads = f"/proc/{child.pid}/task"
+        deadline = time.perf_counter() + 60
+        while not any(_thread_name(threads, task) == "lumiere-work" for task in _listed(threads)):
+            assert time.perf_counter() < deadline and child.poll() is None, "the build never started"
+            time.sleep(0.01)
+        time.sleep(0.3)
         sent = time.perf_counter()
         child.send_signal(signal.SIGINT)
         assert child.stdout.readline().strip() == "KeyboardInterrupt"
         waited = time.perf_counter() - sent
-        assert child.wait(timeout=20) == 7
         assert waited < 1.5, f"the interrupt waited {waited:.2f} s for the build"
+        next_load = float(child.stdout.readline())
+        assert next_load > 0.3, f"the next load started beside the build left running ({next_load:.3f} s)"
+        assert child.wait(timeout=60) == 0
     finally:
         child.kill()
+
+
+def _listed(folder):
+    try:
+        return os.listdir(folder)
+    except FileNotFoundError:
+        return []
+
+
+def _thread_name(tasks, task):
+    try:
+        with open(os.path.join(tasks, task, "comm")) as comm:
+            return comm.read().strip()
+    except OSError:
+        return None
 
 
 def test_write_image_writes_the_cli_bytes(cli, tmp_path):
