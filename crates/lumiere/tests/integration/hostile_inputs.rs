@@ -243,6 +243,21 @@ fn polygon_corners_count_towards_the_estimate() {
     );
 }
 
+/// Joining continued lines copies the text: refused up front, naming it, when the copy would not
+/// fit in the memory left (a trailing backslash is enough to ask for it).
+#[test]
+fn a_continuation_whose_copy_does_not_fit_is_refused() {
+    // 3.5 MiB and a few bytes, shown rounded up.
+    let text = format!("{TRIANGLE}f 1 2 \\\n3\n# {}\n", "padding ".repeat(7 << 16));
+    let no_mtl = |_: &str| Err(io::Error::from(io::ErrorKind::NotFound));
+    let error = parse_obj_with_memory(text.as_bytes(), Path::new("long.obj"), &no_mtl, 2 << 20).unwrap_err();
+    let message = error.to_string();
+    assert!(message.starts_with("long.obj: joining its continued lines needs a copy of its 4 MiB"), "{message}");
+    assert!(message.contains("but only 2 MiB is available"), "{message}");
+    let scene = parse_obj_with_memory(text.as_bytes(), Path::new("long.obj"), &no_mtl, 1 << 30).unwrap();
+    assert_eq!(scene.mesh.triangle_count(), 1);
+}
+
 /// The gzip cap follows the memory given too: a quarter of it.
 #[test]
 fn gzip_inflating_past_a_quarter_of_memory_is_refused() {

@@ -163,10 +163,8 @@ fn parse_obj_within(
     if text::has_lone_carriage_returns(bytes) {
         return Err(Error::parse(name, 1, text::LONE_CARRIAGE_RETURNS));
     }
-    let joined = continued::join_continued_lines(bytes).map_err(|_| {
-        let message = format!("joining its continued lines needs {} more of memory", shown_bytes(bytes.len() as u64));
-        Error::io(name, io::Error::new(io::ErrorKind::OutOfMemory, message))
-    })?;
+    let joined =
+        if continued::has_continuations(bytes) { Some(join_continued_lines(bytes, name, memory)?) } else { None };
     let bytes = joined.as_deref().unwrap_or(bytes);
     let chunks = split_lines(bytes, chunk_bytes.max(1));
     let counts: Vec<ChunkCounts> = chunks.par_iter().map(|chunk| ChunkCounts::of(chunk)).collect();
@@ -225,6 +223,23 @@ fn check_memory(vertices: VertexCounts, triangles: u64, name: &Path, memory: Mem
         shown_bytes(available)
     );
     Err(Error::io(name, io::Error::new(io::ErrorKind::OutOfMemory, message)))
+}
+
+/// The text with its continued lines joined (`obj/continued.rs`), in a copy refused up front, as
+/// a mesh is, when it would not fit in the memory left.
+fn join_continued_lines(bytes: &[u8], name: &Path, memory: Memory) -> Result<Vec<u8>> {
+    let needed = bytes.len() as u64;
+    let refuse = |available: Option<u64>| {
+        let available =
+            available.map_or(String::new(), |bytes| format!(", but only {} is available", shown_bytes(bytes)));
+        let message =
+            format!("joining its continued lines needs a copy of its {}{available}; refusing it", shown_bytes(needed));
+        Error::io(name, io::Error::new(io::ErrorKind::OutOfMemory, message))
+    };
+    match memory.available(needed) {
+        Some(available) if needed > available => Err(refuse(Some(available))),
+        _ => continued::joined(bytes).map_err(|_| refuse(None)),
+    }
 }
 
 /// One warning for all the faces that lost `what` indices because they pointed at nothing.

@@ -10,13 +10,15 @@
 use super::text::lines;
 use std::collections::TryReserveError;
 
-/// `bytes` with every continued statement joined onto its first line, or `None` if no line
-/// continues: the common case, decided by one search for a backslash in files without any.
-/// `Err` if the joined copy does not fit in memory.
-pub(super) fn join_continued_lines(bytes: &[u8]) -> Result<Option<Vec<u8>>, TryReserveError> {
-    if !bytes.contains(&b'\\') || !lines(bytes).any(|line| continuation(line).is_some()) {
-        return Ok(None);
-    }
+/// Whether a line of `bytes` continues on the next: the common answer, no, is found by one
+/// search for a backslash in files without any.
+pub(super) fn has_continuations(bytes: &[u8]) -> bool {
+    bytes.contains(&b'\\') && lines(bytes).any(|line| continuation(line).is_some())
+}
+
+/// `bytes` with every continued statement joined onto its first line, in a copy of the same
+/// length; `Err` if the copy does not fit in memory.
+pub(super) fn joined(bytes: &[u8]) -> Result<Vec<u8>, TryReserveError> {
     let mut joined = Vec::new();
     joined.try_reserve_exact(bytes.len())?;
     let mut swallowed_newlines = 0;
@@ -41,7 +43,7 @@ pub(super) fn join_continued_lines(bytes: &[u8]) -> Result<Option<Vec<u8>>, TryR
     // A continuation on the last line but one or the last: the statement ends with the file.
     joined.resize(joined.len() + swallowed_newlines, b'\n');
     debug_assert_eq!(joined.len(), bytes.len(), "joining keeps the text's length");
-    Ok(Some(joined))
+    Ok(joined)
 }
 
 /// Where the continuing backslash of `line` is: its last byte before trailing whitespace, on a
@@ -59,7 +61,8 @@ mod tests {
     use super::*;
 
     fn joined(text: &str) -> Option<String> {
-        join_continued_lines(text.as_bytes()).expect("fits").map(|bytes| String::from_utf8(bytes).expect("UTF-8"))
+        let bytes = text.as_bytes();
+        has_continuations(bytes).then(|| String::from_utf8(super::joined(bytes).expect("fits")).expect("UTF-8"))
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! MTL (material library) parsing. Lenient by design: a bad line costs a warning, not the scene,
 //! because a render with one wrong material is more useful than no render.
 
-use super::continued::join_continued_lines;
+use super::continued::{has_continuations, joined};
 use super::text::{LONE_CARRIAGE_RETURNS, Tokens, finite_f32, has_lone_carriage_returns, lines, quoted};
 use crate::error::{quote, shown_path};
 use crate::materials::{Material, MaterialKind};
@@ -34,14 +34,18 @@ pub(super) fn parse_mtl(bytes: &[u8], path: &Path, warnings: &mut Warnings) -> V
         return Vec::new();
     }
     // Statements continued with a trailing backslash, joined as in the OBJ file (line numbers kept).
-    let Ok(joined) = join_continued_lines(bytes) else {
-        warnings.push(path, "MTL files too large to join", || {
-            format!(
-                "{}: joining its continued lines needs more memory than is left; its materials are not read",
-                shown_path(path)
-            )
-        });
-        return Vec::new();
+    let joined = match has_continuations(bytes).then(|| joined(bytes)) {
+        None => None,
+        Some(Ok(joined)) => Some(joined),
+        Some(Err(_)) => {
+            warnings.push(path, "MTL files too large to join", || {
+                format!(
+                    "{}: joining its continued lines needs more memory than is left; its materials are not read",
+                    shown_path(path)
+                )
+            });
+            return Vec::new();
+        }
     };
     let bytes = joined.as_deref().unwrap_or(bytes);
     let mut materials: Vec<Material> = Vec::new();
