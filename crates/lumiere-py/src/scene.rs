@@ -95,10 +95,15 @@ impl PyScene {
         normals: Option<&[u8]>,
     ) -> PyResult<Self> {
         // Copied while the GIL is held (the buffers are Python's), converted away from it.
-        let (positions, indices, material_ids) = (positions.to_vec(), indices.to_vec(), material_ids.to_vec());
-        let normals = normals.map(<[u8]>::to_vec);
-        let scene = move || scene_from_arrays(name, &positions, &indices, &material_ids, materials, normals.as_deref());
-        PyScene::finish(py, scene, Vec::new(), false)
+        let arrays = Arrays {
+            name,
+            positions: positions.to_vec(),
+            indices: indices.to_vec(),
+            material_ids: material_ids.to_vec(),
+            materials,
+            normals: normals.map(<[u8]>::to_vec),
+        };
+        PyScene::finish(py, move || arrays.into_scene(), Vec::new(), false)
     }
 
     #[getter]
@@ -183,44 +188,50 @@ fn placement(py: Python<'_>, transform: UvTransform) -> PyResult<Option<Bound<'_
     Ok(Some(entry))
 }
 
-/// The scene of [`PyScene::from_arrays`]'s buffers (native-endian float32 and uint32 values).
-fn scene_from_arrays(
+/// [`PyScene::from_arrays`]'s buffers, copied out of Python: native-endian float32 and uint32
+/// values.
+struct Arrays {
     name: String,
-    positions: &[u8],
-    indices: &[u8],
-    material_ids: &[u8],
+    positions: Vec<u8>,
+    indices: Vec<u8>,
+    material_ids: Vec<u8>,
     materials: Vec<MaterialSpec>,
-    normals: Option<&[u8]>,
-) -> lumiere::Result<Scene> {
-    let floats = |b: &[u8]| b.chunks_exact(4).map(|c| f32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect::<Vec<_>>();
-    let ints = |b: &[u8]| b.chunks_exact(4).map(|c| u32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect::<Vec<_>>();
-    let vec3s = |v: Vec<f32>| v.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect::<Vec<_>>();
-    let positions = vec3s(floats(positions));
-    if let Some(bad) = positions.iter().position(|p| !p.is_finite()) {
-        return Err(lumiere::Error::invalid(format!("{name}: vertex {bad} is not finite")));
+    normals: Option<Vec<u8>>,
+}
+
+impl Arrays {
+    fn into_scene(self) -> lumiere::Result<Scene> {
+        let name = self.name;
+        let floats =
+            |b: &[u8]| b.chunks_exact(4).map(|c| f32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect::<Vec<_>>();
+        let ints =
+            |b: &[u8]| b.chunks_exact(4).map(|c| u32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect::<Vec<_>>();
+        let vec3s = |v: Vec<f32>| v.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect::<Vec<_>>();
+        let positions = vec3s(floats(&self.positions));
+        if let Some(bad) = positions.iter().position(|p| !p.is_finite()) {
+            return Err(lumiere::Error::invalid(format!("{name}: vertex {bad} is not finite")));
+        }
+        let indices: Vec<[u32; 3]> = ints(&self.indices).chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+        let normals = self.normals.map(|n| vec3s(floats(&n))).unwrap_or_default();
+        if !normals.is_empty() && normals.len() != positions.len() {
+            let message = format!("{name}: {} normals for {} vertices", normals.len(), positions.len());
+            return Err(lumiere::Error::invalid(message));
+        }
+        let normal_indices = if normals.is_empty() { Vec::new() } else { indices.clone() };
+        let mesh = TriangleMesh {
+            material_ids: ints(&self.material_ids),
+            positions,
+            indices,
+            normals,
+            normal_indices,
+            texcoords: Vec::<Vec2>::new(),
+            texcoord_indices: Vec::new(),
+        };
+        let materials = self
+            .materials
+            .into_iter()
+            .map(|(name, kd, ke)| Material { kd: Vec3::from(kd), ke: Vec3::from(ke), ..Material::default_grey(&name) })
+            .collect();
+        Scene::from_parts(name, mesh, materials, Vec::new())
     }
-    let indices: Vec<[u32; 3]> = ints(indices).chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
-    let normals = normals.map(|n| vec3s(floats(n))).unwrap_or_default();
-    if !normals.is_empty() && normals.len() != positions.len() {
-        return Err(lumiere::Error::invalid(format!(
-            "{name}: {} normals for {} vertices",
-            normals.len(),
-            positions.len()
-        )));
-    }
-    let normal_indices = if normals.is_empty() { Vec::new() } else { indices.clone() };
-    let mesh = TriangleMesh {
-        material_ids: ints(material_ids),
-        positions,
-        indices,
-        normals,
-        normal_indices,
-        texcoords: Vec::<Vec2>::new(),
-        texcoord_indices: Vec::new(),
-    };
-    let materials = materials
-        .into_iter()
-        .map(|(name, kd, ke)| Material { kd: Vec3::from(kd), ke: Vec3::from(ke), ..Material::default_grey(&name) })
-        .collect();
-    Scene::from_parts(name, mesh, materials, Vec::new())
 }
