@@ -19,7 +19,7 @@ use crate::camera::PyCamera;
 use crate::errors::{OrPyErr, invalid, unsigned};
 use crate::options::PyOptions;
 use crate::pixels::{from_bytes, to_bytearray};
-use crate::render::pool;
+use crate::pools;
 use crate::scene::PyScene;
 use crate::watch;
 
@@ -44,7 +44,7 @@ pub fn render_passes<'py>(
     let (first, count) = (unsigned(first, "first", max)? as u32, unsigned(count, "count", max)? as u32);
     let threads = unsigned(threads, "threads", max)? as usize;
     let (world, camera, options) = (&*scene.world, &camera.camera, &options.options);
-    let pool = pool(threads)?;
+    let pool = pools::for_render(threads)?;
     let total = u64::from(camera.width) * u64::from(camera.height) * u64::from(count);
     // Leaves no warnings: any stack level does.
     let passes = watch::run(py, Some(total), progress.as_ref(), 1, |watch| {
@@ -76,7 +76,7 @@ impl PyFilm {
     fn add_pass(&mut self, sample: u32, values: &[u8], rays: u64) -> PyResult<()> {
         let values = from_bytes(values, self.film.pixel_count(), &format!("pass {sample}"))?;
         let pass = PassSamples { sample, width: self.film.width, height: self.film.height, values, rays };
-        self.film.add_pass(&pass).or_py()?;
+        pools::install(|| self.film.add_pass(&pass))?.or_py()?;
         // A count this large is nonsense, but it must not wrap around to a small one.
         self.stats.rays = self.stats.rays.saturating_add(rays);
         Ok(())
@@ -117,7 +117,7 @@ impl PyFilm {
 
     /// The current estimate as float32 RGB bytes, row 0 at the top.
     fn image<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyByteArray>> {
-        to_bytearray(py, &self.film.image().pixels)
+        to_bytearray(py, &pools::install(|| self.film.image())?.pixels)
     }
 
     /// Saves the film as a checkpoint of the render of `scene`, `camera` and `options`: the
@@ -148,14 +148,15 @@ impl PyFilm {
             film: self.film.clone(),
             stats: self.stats,
         };
-        py.detach(|| checkpoint.save(&path)).or_py()
+        let pool = pools::for_work()?;
+        py.detach(|| pool.install(|| checkpoint.save(&path))).or_py()
     }
 
     /// The film of a checkpoint, refused (naming what differs) unless it was rendered from the
     /// same scene and options.
     #[staticmethod]
     fn load_checkpoint(path: PathBuf, scene: &PyScene, camera: &PyCamera, options: &PyOptions) -> PyResult<Self> {
-        let checkpoint = Checkpoint::load(&path).or_py()?;
+        let checkpoint = pools::install(|| Checkpoint::load(&path))?.or_py()?;
         if checkpoint.scene_fingerprint != scene.fingerprint {
             return Err(invalid(format!(
                 "{}: cannot resume: the checkpoint was rendered from a different scene (geometry, materials or emission)",

@@ -10,6 +10,7 @@ use pyo3::prelude::*;
 
 use crate::errors::{OrPyErr, invalid};
 use crate::pixels::from_bytes;
+use crate::pools;
 
 /// Writes float32 RGB `pixels` (row 0 at the top) to `path`; the extension picks the format.
 #[pyfunction]
@@ -25,7 +26,8 @@ pub fn write_image(
 ) -> PyResult<()> {
     let style = png_style(exposure, tonemap)?;
     let pixels = from_bytes(pixels, width as usize * height as usize, "image")?;
-    py.detach(|| write(&path, width, height, &pixels, style)).or_py()
+    let pool = pools::for_work()?;
+    py.detach(|| pool.install(|| write(&path, width, height, &pixels, style))).or_py()
 }
 
 /// Refuses, before a long render, an image output that [`write_image`] would refuse after it: a

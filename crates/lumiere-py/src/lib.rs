@@ -9,6 +9,7 @@ mod film;
 mod image;
 mod options;
 mod pixels;
+mod pools;
 mod render;
 mod scene;
 mod watch;

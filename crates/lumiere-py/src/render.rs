@@ -1,8 +1,6 @@
 //! `render`: a whole render on a pool of `threads`, with the GIL released (see `watch.rs`), and the
 //! AOVs asked for; returns the image and AOVs as float32 bytes and the render's statistics.
 
-use std::sync::{Arc, Mutex};
-
 use lumiere::render::aov::{Aov, render_aovs};
 use lumiere::render::film::{Film, check_memory};
 use lumiere::render::forecast::{NoiseForecast, shown_number};
@@ -12,35 +10,12 @@ use pyo3::prelude::*;
 use pyo3::types::{PyByteArray, PyDict};
 
 use crate::camera::PyCamera;
-use crate::errors::{OrPyErr, invalid};
+use crate::errors::OrPyErr;
 use crate::options::PyOptions;
 use crate::pixels::to_bytearray;
+use crate::pools;
 use crate::scene::PyScene;
 use crate::watch::{self, Watch};
-
-/// The most worker threads a render may ask for, as the CLI's `--threads`.
-const MAX_THREADS: usize = 1024;
-
-/// A rayon pool of `threads` workers (0: `RAYON_NUM_THREADS` or one per core), as the CLI builds
-/// it, kept for the next render with that many: starting threads for every call would cost
-/// milliseconds a render. Only the last pool is kept (its threads live as long as it does), so a
-/// notebook that tries one thread count after another does not pile up threads; a render still
-/// running on a replaced pool keeps it until it ends.
-pub fn pool(threads: usize) -> PyResult<Arc<rayon::ThreadPool>> {
-    if threads > MAX_THREADS {
-        return Err(invalid(format!("threads must be at most {MAX_THREADS}, got {threads}")));
-    }
-    static LAST: Mutex<Option<(usize, Arc<rayon::ThreadPool>)>> = Mutex::new(None);
-    let mut last = LAST.lock().unwrap_or_else(|e| e.into_inner());
-    if let Some((count, pool)) = &*last
-        && *count == threads
-    {
-        return Ok(pool.clone());
-    }
-    let pool = Arc::new(lumiere::util::threads::pool(threads).or_py()?);
-    *last = Some((threads, pool.clone()));
-    Ok(pool)
-}
 
 type Rendered<'py> = (Bound<'py, PyByteArray>, Vec<Bound<'py, PyByteArray>>, Bound<'py, PyDict>);
 
@@ -64,7 +39,7 @@ pub fn render<'py>(
     if !aovs.is_empty() {
         check_memory(camera.width, camera.height, aovs.len() as u64 * 24 + 12, " with its AOVs").or_py()?;
     }
-    let pool = pool(threads)?;
+    let pool = pools::for_render(threads)?;
     let threads = pool.current_num_threads();
     let pixels = u64::from(camera.width) * u64::from(camera.height);
     let total = (options.spp != u32::MAX).then(|| pixels * u64::from(options.spp));

@@ -18,7 +18,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::errors::OrPyErr;
-use crate::watch;
+use crate::{pools, watch};
 
 /// A scene ready to render (its BVH and lights built).
 #[pyclass(module = "lumiere._lumiere", name = "NativeScene", frozen)]
@@ -49,16 +49,19 @@ impl PyScene {
         builtin: bool,
     ) -> PyResult<Self> {
         let start = Instant::now();
+        let pool = pools::for_work()?;
         let (world, fingerprint, load_seconds, build_seconds) = watch::abandonable(py, move || {
-            let mut scene = scene()?;
-            for (name, ke) in emission {
-                scene.set_emission(&name, Vec3::from(ke))?;
-            }
-            let load_seconds = start.elapsed().as_secs_f64();
-            let fingerprint = scene_fingerprint(&scene);
-            let build = Instant::now();
-            let world = World::new(scene, BuildPreset::Default);
-            Ok((world, fingerprint, load_seconds, build.elapsed().as_secs_f64()))
+            pool.install(|| {
+                let mut scene = scene()?;
+                for (name, ke) in emission {
+                    scene.set_emission(&name, Vec3::from(ke))?;
+                }
+                let load_seconds = start.elapsed().as_secs_f64();
+                let fingerprint = scene_fingerprint(&scene);
+                let build = Instant::now();
+                let world = World::new(scene, BuildPreset::Default);
+                Ok((world, fingerprint, load_seconds, build.elapsed().as_secs_f64()))
+            })
         })?
         .or_py()?;
         Ok(PyScene { world: Arc::new(world), builtin, fingerprint, load_seconds, build_seconds })

@@ -81,8 +81,9 @@ pub fn run<T: Send>(
     Ok(value)
 }
 
-/// Work that a Ctrl-C left running in the background (see [`abandonable`]).
-static LEFT_RUNNING: Mutex<Vec<JoinHandle<()>>> = Mutex::new(Vec::new());
+/// Work that a Ctrl-C left running in the background (see [`abandonable`]), with the process
+/// that started it: a child forked meanwhile inherits the handles, not the threads.
+static LEFT_RUNNING: Mutex<(u32, Vec<JoinHandle<()>>)> = Mutex::new((0, Vec::new()));
 
 /// Runs `work`, which the library cannot stop part-way (loading a scene, building its BVH), on a
 /// thread of its own while the calling thread sleeps without the GIL, waking every few
@@ -111,7 +112,9 @@ pub fn abandonable<T: Send + 'static>(py: Python<'_>, work: impl FnOnce() -> T +
             Ok(value) => return Ok(value),
             Err(RecvTimeoutError::Timeout) => {
                 if let Err(interrupt) = py.check_signals() {
-                    LEFT_RUNNING.lock().unwrap_or_else(|e| e.into_inner()).push(worker);
+                    let mut left = LEFT_RUNNING.lock().unwrap_or_else(|e| e.into_inner());
+                    left.0 = std::process::id();
+                    left.1.push(worker);
                     return Err(interrupt);
                 }
             }
@@ -128,8 +131,13 @@ pub fn abandonable<T: Send + 'static>(py: Python<'_>, work: impl FnOnce() -> T +
 fn wait_for_work_left_running(py: Python<'_>) -> PyResult<()> {
     loop {
         let mut left = LEFT_RUNNING.lock().unwrap_or_else(|e| e.into_inner());
-        left.retain(|worker| !worker.is_finished());
-        if left.is_empty() {
+        if left.0 != std::process::id() {
+            // Forked: the threads are the parent's. Their handles are forgotten, never dropped
+            // (which would detach threads that do not exist here).
+            std::mem::forget(std::mem::take(&mut left.1));
+        }
+        left.1.retain(|worker| !worker.is_finished());
+        if left.1.is_empty() {
             return Ok(());
         }
         drop(left);

@@ -458,6 +458,25 @@ def test_ctrl_c_while_a_scene_builds_raises_keyboard_interrupt_at_once():
         child.kill()
 
 
+def test_a_process_forked_after_rendering_loads_and_renders_too():
+    # multiprocessing's "fork" (the default on Linux before Python 3.14) copies the thread pools
+    # a load or a render started, but not their threads: work handed to them waited forever.
+    script = textwrap.dedent(
+        """
+        import multiprocessing, lumiere
+        def render(_):
+            return lumiere.render(lumiere.builtin(), spp=1, size=(32, 24), threads=2).tobytes()
+        if __name__ == "__main__":
+            parent = render(0)
+            with multiprocessing.get_context("fork").Pool(1) as pool:
+                child = pool.apply_async(render, (0,)).get(timeout=20)
+            print("same" if child == parent else "different", flush=True)
+        """
+    )
+    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert result.stdout.strip() == "same", result.stderr[-2000:]
+
+
 def _listed(folder):
     try:
         return os.listdir(folder)
