@@ -43,11 +43,13 @@ pub fn render_passes<'py>(
     let max = u64::from(u32::MAX);
     let (first, count) = (unsigned(first, "first", max)? as u32, unsigned(count, "count", max)? as u32);
     let threads = unsigned(threads, "threads", max)? as usize;
-    let (world, camera, options) = (&*scene.world, &camera.camera, &options.options);
+    // Owned by the render's thread (see `watch::run`).
+    let (world, camera, options) = (scene.world.clone(), camera.camera.clone(), options.options.clone());
     let pool = pools::for_render(threads)?;
     let total = u64::from(camera.width) * u64::from(camera.height) * u64::from(count);
     // Leaves no warnings: any stack level does.
-    let passes = watch::run(py, Some(total), progress.as_ref(), 1, |watch| {
+    let passes = watch::run(py, Some(total), progress.as_ref(), 1, move |watch| {
+        let (world, camera, options) = (&*world, &camera, &options);
         let count_samples = |n| {
             watch.done.fetch_add(n, std::sync::atomic::Ordering::Relaxed);
         };

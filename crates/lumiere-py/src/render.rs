@@ -33,7 +33,8 @@ pub fn render<'py>(
     stacklevel: i32,
 ) -> PyResult<Rendered<'py>> {
     let aovs = aovs.iter().map(|name| Aov::parse(name)).collect::<lumiere::Result<Vec<_>>>().or_py()?;
-    let (world, camera, options) = (&*scene.world, &camera.camera, &options.options);
+    // Owned by the render's thread (see `watch::run`).
+    let (world, camera, options) = (scene.world.clone(), camera.camera.clone(), options.options.clone());
     // As the CLI's check before rendering: each AOV's buffer and its bytes for numpy, and the
     // image's bytes, beside the film (a huge image's AOVs aborted the interpreter once rendered).
     if !aovs.is_empty() {
@@ -43,7 +44,8 @@ pub fn render<'py>(
     let threads = pool.current_num_threads();
     let pixels = u64::from(camera.width) * u64::from(camera.height);
     let total = (options.spp != u32::MAX).then(|| pixels * u64::from(options.spp));
-    let work = |watch: &Watch| {
+    let work = move |watch: &Watch| {
+        let (world, camera, options) = (&*world, &camera, &options);
         pool.install(|| {
             let film = Film::new(camera.width, camera.height)?;
             let warn = |message: String| watch.warnings.lock().unwrap_or_else(|e| e.into_inner()).push(message);

@@ -9,14 +9,14 @@
 use std::ffi::CString;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc::{self, RecvTimeoutError};
-use std::sync::{Condvar, Mutex};
+use std::sync::{Arc, Condvar, Mutex};
 use std::thread::JoinHandle;
 use std::time::Duration;
 
 use pyo3::exceptions::{PyOSError, PyRuntimeWarning};
 use pyo3::prelude::*;
 
-use crate::errors::to_py;
+use crate::errors::{invalid, to_py};
 
 /// How often the waiting thread checks signals and reports progress.
 const POLL: Duration = Duration::from_millis(25);
@@ -31,44 +31,57 @@ pub struct Watch {
 
 /// Runs `work` on a new thread; calls `progress(done, total)` as `watch.done` moves (and once at
 /// the end), and issues the warnings it leaves `stacklevel` frames up from the caller (1: the
-/// caller's line). The result of `work`, or the first signal or callback exception.
-pub fn run<T: Send>(
+/// caller's line). The result of `work`, or the first signal or callback exception. The thread
+/// owns what it works on, so that a process forked meanwhile (from a `progress` callback), which
+/// has no such thread, can give up on it instead of waiting forever.
+pub fn run<T: Send + 'static>(
     py: Python<'_>,
     total: Option<u64>,
     progress: Option<&Bound<'_, PyAny>>,
     stacklevel: i32,
-    work: impl FnOnce(&Watch) -> lumiere::Result<T> + Send,
+    work: impl FnOnce(&Watch) -> lumiere::Result<T> + Send + 'static,
 ) -> PyResult<T> {
-    let watch = Watch { cancel: AtomicBool::new(false), done: AtomicU64::new(0), warnings: Mutex::new(Vec::new()) };
-    let finished = Finished::default();
+    let watch =
+        Arc::new(Watch { cancel: AtomicBool::new(false), done: AtomicU64::new(0), warnings: Mutex::new(Vec::new()) });
+    let finished = Arc::new(Finished::default());
+    let worker = {
+        let (watch, finished) = (watch.clone(), finished.clone());
+        std::thread::Builder::new()
+            .name("lumiere-render".into())
+            .spawn(move || {
+                // Dropped when the work returns or panics: either way the waiting thread wakes.
+                let _signal = SignalOnDrop(&finished);
+                work(&watch)
+            })
+            .map_err(|e| PyOSError::new_err(format!("cannot start a thread for the render: {e}")))?
+    };
+    let process = std::process::id();
     let mut failure: Option<PyErr> = None;
     let mut reported = None;
-    let result = std::thread::scope(|scope| {
-        let (watch, finished) = (&watch, &finished);
-        let worker = scope.spawn(move || {
-            // Dropped when the work returns or panics: either way the waiting thread wakes.
-            let _signal = SignalOnDrop(finished);
-            work(watch)
-        });
-        loop {
-            let over = py.detach(|| finished.wait(POLL));
-            if failure.is_none() {
-                let step = py
-                    .check_signals()
-                    .and_then(|()| warn(py, &watch.warnings, stacklevel))
-                    .and_then(|()| report(progress, &watch.done, total, &mut reported));
-                if let Err(e) = step {
-                    watch.cancel.store(true, Ordering::SeqCst);
-                    failure = Some(e);
-                }
-            }
-            if over {
-                break;
+    loop {
+        let over = py.detach(|| finished.wait(POLL));
+        if std::process::id() != process {
+            // The handle is the parent's thread's: forgotten, never joined or detached here.
+            std::mem::forget(worker);
+            return Err(invalid(
+                "this process was forked during a render, which it cannot go on with: the render's thread stayed in the parent",
+            ));
+        }
+        if failure.is_none() {
+            let step = py
+                .check_signals()
+                .and_then(|()| warn(py, &watch.warnings, stacklevel))
+                .and_then(|()| report(progress, &watch.done, total, &mut reported));
+            if let Err(e) = step {
+                watch.cancel.store(true, Ordering::SeqCst);
+                failure = Some(e);
             }
         }
-        py.detach(|| worker.join())
-    });
-    let result = match result {
+        if over {
+            break;
+        }
+    }
+    let result = match py.detach(move || worker.join()) {
         Ok(result) => result,
         Err(panic) => std::panic::resume_unwind(panic),
     };

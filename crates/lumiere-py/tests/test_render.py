@@ -477,6 +477,32 @@ def test_a_process_forked_after_rendering_loads_and_renders_too():
     assert result.stdout.strip() == "same", result.stderr[-2000:]
 
 
+def test_a_process_forked_from_a_progress_callback_gives_up_the_render():
+    # The child has no render thread (a fork copies only the calling one): it must say so
+    # rather than wait for that thread forever; the parent renders on.
+    script = textwrap.dedent(
+        """
+        import os, lumiere
+        forked = []
+        def progress(done, total):
+            if not forked:
+                forked.append(os.fork())
+        try:
+            lumiere.render(lumiere.builtin(), spp=50, size=(128, 96), progress=progress)
+            print("rendered" if forked[0] else "child rendered", flush=True)
+        except lumiere.LumiereError as error:
+            print(f"child: {error}", flush=True)
+        if forked[0] == 0:
+            os._exit(0)
+        os.waitpid(forked[0], 0)
+        """
+    )
+    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=60)
+    lines = sorted(result.stdout.splitlines())
+    assert len(lines) == 2 and lines[1] == "rendered", (result.stdout, result.stderr[-2000:])
+    assert lines[0].startswith("child: this process was forked during a render"), lines
+
+
 def _listed(folder):
     try:
         return os.listdir(folder)
