@@ -8,8 +8,8 @@
 
 use std::ffi::CString;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::mpsc::{self, RecvTimeoutError};
-use std::sync::{Arc, Condvar, Mutex};
+use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
+use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::Duration;
 
@@ -43,30 +43,14 @@ pub fn run<T: Send + 'static>(
 ) -> PyResult<T> {
     let watch =
         Arc::new(Watch { cancel: AtomicBool::new(false), done: AtomicU64::new(0), warnings: Mutex::new(Vec::new()) });
-    let finished = Arc::new(Finished::default());
-    let worker = {
-        let (watch, finished) = (watch.clone(), finished.clone());
-        std::thread::Builder::new()
-            .name("lumiere-render".into())
-            .spawn(move || {
-                // Dropped when the work returns or panics: either way the waiting thread wakes.
-                let _signal = SignalOnDrop(&finished);
-                work(&watch)
-            })
-            .map_err(|e| PyOSError::new_err(format!("cannot start a thread for the render: {e}")))?
-    };
-    let process = std::process::id();
+    let mut worker = Worker::spawn("a render", {
+        let watch = watch.clone();
+        move || work(&watch)
+    })?;
     let mut failure: Option<PyErr> = None;
     let mut reported = None;
-    loop {
-        let over = py.detach(|| finished.wait(POLL));
-        if std::process::id() != process {
-            // The handle is the parent's thread's: forgotten, never joined or detached here.
-            std::mem::forget(worker);
-            return Err(invalid(
-                "this process was forked during a render, which it cannot go on with: the render's thread stayed in the parent",
-            ));
-        }
+    let result = loop {
+        let result = worker.wait(py)?;
         if failure.is_none() {
             let step = py
                 .check_signals()
@@ -77,13 +61,9 @@ pub fn run<T: Send + 'static>(
                 failure = Some(e);
             }
         }
-        if over {
-            break;
+        if let Some(result) = result {
+            break result;
         }
-    }
-    let result = match py.detach(move || worker.join()) {
-        Ok(result) => result,
-        Err(panic) => std::panic::resume_unwind(panic),
     };
     if let Some(e) = failure {
         return Err(e);
@@ -106,36 +86,16 @@ static LEFT_RUNNING: Mutex<(u32, Vec<JoinHandle<()>>)> = Mutex::new((0, Vec::new
 /// interrupting a load again and again never piles up scenes in memory.
 pub fn abandonable<T: Send + 'static>(py: Python<'_>, work: impl FnOnce() -> T + Send + 'static) -> PyResult<T> {
     wait_for_work_left_running(py)?;
-    let (send, mut receive) = mpsc::sync_channel(1);
-    let worker = std::thread::Builder::new()
-        .name("lumiere-work".into())
-        .spawn(move || {
-            // The receiver is gone once the caller was interrupted: the result is dropped here.
-            let _ = send.send(work());
-        })
-        .map_err(|e| PyOSError::new_err(format!("cannot start a thread for the work: {e}")))?;
+    let mut worker = Worker::spawn("a load", work)?;
     loop {
-        // The receiver goes into the GIL-free wait and comes back out: it cannot be shared.
-        let (back, received) = py.detach(move || {
-            let received = receive.recv_timeout(POLL);
-            (receive, received)
-        });
-        receive = back;
-        match received {
-            Ok(value) => return Ok(value),
-            Err(RecvTimeoutError::Timeout) => {
-                if let Err(interrupt) = py.check_signals() {
-                    let mut left = LEFT_RUNNING.lock().unwrap_or_else(|e| e.into_inner());
-                    left.0 = std::process::id();
-                    left.1.push(worker);
-                    return Err(interrupt);
-                }
-            }
-            // The work panicked before sending anything: the panic goes on here.
-            Err(RecvTimeoutError::Disconnected) => match worker.join() {
-                Err(panic) => std::panic::resume_unwind(panic),
-                Ok(()) => unreachable!("the worker sends its result before it ends"),
-            },
+        if let Some(value) = worker.wait(py)? {
+            return Ok(value);
+        }
+        if let Err(interrupt) = py.check_signals() {
+            let mut left = LEFT_RUNNING.lock().unwrap_or_else(|e| e.into_inner());
+            left.0 = worker.process;
+            left.1.extend(worker.thread.take());
+            return Err(interrupt);
         }
     }
 }
@@ -187,27 +147,56 @@ fn report(
     Ok(())
 }
 
-/// Set once the work is over, waking the waiting thread at once rather than at its next poll.
-#[derive(Default)]
-struct Finished {
-    over: Mutex<bool>,
-    wake: Condvar,
+/// Work on a thread of its own, whose result comes back through a channel: the waiting thread
+/// wakes as soon as it is sent, or as soon as the work panics and the sender is dropped.
+struct Worker<T> {
+    /// `None` once the thread was joined or handed over.
+    thread: Option<JoinHandle<()>>,
+    /// `None` only while a wait holds it: a receiver cannot be shared with the GIL-free wait.
+    receive: Option<Receiver<T>>,
+    /// The process that started the thread: a child forked meanwhile has no such thread.
+    process: u32,
+    /// What the work is, for the forked child's message ("a render").
+    what: &'static str,
 }
 
-impl Finished {
-    /// Waits up to `timeout`; whether the work is over.
-    fn wait(&self, timeout: Duration) -> bool {
-        let over = self.over.lock().unwrap_or_else(|e| e.into_inner());
-        let (over, _) = self.wake.wait_timeout_while(over, timeout, |over| !*over).unwrap_or_else(|e| e.into_inner());
-        *over
+impl<T: Send + 'static> Worker<T> {
+    fn spawn(what: &'static str, work: impl FnOnce() -> T + Send + 'static) -> PyResult<Self> {
+        let (send, receive) = mpsc::sync_channel(1);
+        let thread = std::thread::Builder::new()
+            .name("lumiere-work".into())
+            .spawn(move || {
+                // Refused once the caller left the work running: the result is dropped here.
+                let _ = send.send(work());
+            })
+            .map_err(|e| PyOSError::new_err(format!("cannot start a thread for {what}: {e}")))?;
+        Ok(Worker { thread: Some(thread), receive: Some(receive), process: std::process::id(), what })
     }
-}
 
-struct SignalOnDrop<'a>(&'a Finished);
-
-impl Drop for SignalOnDrop<'_> {
-    fn drop(&mut self) {
-        *self.0.over.lock().unwrap_or_else(|e| e.into_inner()) = true;
-        self.0.wake.notify_all();
+    /// Waits up to [`POLL`] without the GIL: the result, if the work is over; its panic goes on
+    /// here. In a process forked since the work started, an error: its thread stayed in the parent.
+    fn wait(&mut self, py: Python<'_>) -> PyResult<Option<T>> {
+        let receive = self.receive.take().expect("a wait at a time");
+        let (receive, received) = py.detach(move || {
+            let received = receive.recv_timeout(POLL);
+            (receive, received)
+        });
+        self.receive = Some(receive);
+        if std::process::id() != self.process {
+            // The handle is the parent's thread's: forgotten, never joined or detached here.
+            std::mem::forget(self.thread.take());
+            return Err(invalid(format!(
+                "this process was forked during {}, which it cannot go on with: its thread stayed in the parent",
+                self.what
+            )));
+        }
+        match received {
+            Ok(value) => Ok(Some(value)),
+            Err(RecvTimeoutError::Timeout) => Ok(None),
+            Err(RecvTimeoutError::Disconnected) => match self.thread.take().map(JoinHandle::join) {
+                Some(Err(panic)) => std::panic::resume_unwind(panic),
+                _ => unreachable!("the work sends its result before it ends"),
+            },
+        }
     }
 }

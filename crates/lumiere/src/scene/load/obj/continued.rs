@@ -7,7 +7,7 @@
 //! the end of the statement, as a blank line. So every line after a joined statement keeps its
 //! number in messages, and a joined statement is reported at its first line.
 
-use super::text::lines;
+use super::text::{comment_start, lines};
 use std::collections::TryReserveError;
 
 /// Whether a line of `bytes` continues on the next: the common answer, no, is found by one
@@ -52,8 +52,7 @@ pub(super) fn joined(bytes: &[u8]) -> Result<Vec<u8>, TryReserveError> {
 fn continuation(line: &[u8]) -> Option<usize> {
     let body = line.trim_ascii_end();
     let backslash = body.len().checked_sub(1).filter(|&last| body[last] == b'\\')?;
-    let comment = line.iter().enumerate().any(|(i, &b)| b == b'#' && (i == 0 || line[i - 1].is_ascii_whitespace()));
-    (!comment).then_some(backslash)
+    comment_start(line).is_none().then_some(backslash)
 }
 
 #[cfg(test)]

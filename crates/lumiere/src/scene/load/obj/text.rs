@@ -43,12 +43,7 @@ impl<'a> Tokens<'a> {
     /// keep them, so that a name in the file's own encoding finds its file.
     pub(super) fn remainder_bytes(self) -> &'a [u8] {
         let rest = self.rest.trim_ascii_start();
-        let comment = rest
-            .iter()
-            .enumerate()
-            .position(|(i, &b)| b == b'#' && (i == 0 || rest[i - 1].is_ascii_whitespace()))
-            .unwrap_or(rest.len());
-        rest[..comment].trim_ascii_end()
+        rest[..comment_start(rest).unwrap_or(rest.len())].trim_ascii_end()
     }
 
     /// What is left of the line, trimmed, as one name (see [`text`]): material and file names may
@@ -56,6 +51,11 @@ impl<'a> Tokens<'a> {
     pub(super) fn remainder(self) -> Cow<'a, str> {
         text(self.remainder_bytes())
     }
+}
+
+/// Where a comment starts in `line`: at a `#` that begins a token (`Material#1` keeps its `#`).
+pub(super) fn comment_start(line: &[u8]) -> Option<usize> {
+    line.iter().enumerate().position(|(i, &b)| b == b'#' && (i == 0 || line[i - 1].is_ascii_whitespace()))
 }
 
 /// A name as text: UTF-8 where it is valid, otherwise each byte read as Latin-1, as older
