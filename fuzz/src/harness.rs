@@ -33,13 +33,14 @@ pub const CHECKPOINT_NAME: &str = "fuzz.ckpt";
 pub type Target = fn(&[u8]) -> Result<(), String>;
 
 /// Every target, by the name of its `fuzz_targets/*.rs` file and `fuzz/corpus/` folder.
-pub const TARGETS: [(&str, Target); 6] = [
+pub const TARGETS: [(&str, Target); 7] = [
     ("obj", obj_target),
     ("obj_chunks", obj_chunks_target),
     ("mtl", mtl_target),
     ("orbiter", orbiter_target),
     ("scene", scene_target),
     ("checkpoint", checkpoint_target),
+    ("gunzip", gunzip_target),
 ];
 
 /// Splits a fuzz input at its first NUL byte: the OBJ text before it and, when there is one, the
@@ -315,6 +316,47 @@ pub fn checkpoint_target(data: &[u8]) -> Result<(), String> {
             Ok(())
         }
     }
+}
+
+/// Target `gunzip`: `util::read::gunzip`, the inflation of `.obj.gz` files with its size limit.
+/// First byte: the limit, in units of 64 bytes (0 to 16,320, small so that inputs meet it often);
+/// rest: the file. Whatever it accepts must fit the limit and come back the same when the limit
+/// is exactly its size or when zero padding follows the stream, and one byte less must be refused
+/// as too large; whatever it refuses, it refuses with one line.
+pub fn gunzip_target(data: &[u8]) -> Result<(), String> {
+    use lumiere::util::read::gunzip;
+    let Some((&units, raw)) = data.split_first() else { return Ok(()) };
+    let limit = u64::from(units) * 64;
+    let text = match gunzip(raw, limit) {
+        Ok(text) => text,
+        Err(error) => {
+            let message = error.to_string();
+            return if message.is_empty() || message.contains('\n') {
+                Err(format!("error is not one line: {message:?}"))
+            } else {
+                Ok(())
+            };
+        }
+    };
+    let size = text.len() as u64;
+    if size > limit {
+        return Err(format!("inflated {size} bytes over a limit of {limit}"));
+    }
+    let same = |result: io::Result<Vec<u8>>, what: &str| match result {
+        Ok(again) if again == text => Ok(()),
+        Ok(again) => Err(format!("{what}: {} bytes, not the {size} inflated first", again.len())),
+        Err(error) => Err(format!("{what}: refused ({error}) after {size} bytes were accepted")),
+    };
+    same(gunzip(raw, size), "a limit of exactly the inflated size")?;
+    same(gunzip(&[raw, &[0; 16]].concat(), limit), "the same stream followed by zero padding")?;
+    if size > 0 {
+        match gunzip(raw, size - 1) {
+            Err(error) if error.kind() == io::ErrorKind::OutOfMemory => {}
+            Err(error) => return Err(format!("a limit one byte short gives another error: {error}")),
+            Ok(short) => return Err(format!("a limit one byte short still gives {} bytes", short.len())),
+        }
+    }
+    Ok(())
 }
 
 /// Header fields of checkpoint bytes (after the magic), if they are long enough to hold them:
