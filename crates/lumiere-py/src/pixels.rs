@@ -24,6 +24,10 @@ pub fn from_bytes(bytes: &[u8], count: usize, what: &str) -> PyResult<Vec<Vec3>>
     if bytes.len() != count * 12 {
         return Err(invalid(format!("{what}: {} bytes, expected {count} float32 RGB values", bytes.len())));
     }
+    // Reserved fallibly: an image too large for the memory left is an exception, not an abort.
+    let mut pixels = Vec::new();
+    pixels.try_reserve_exact(count).map_err(|_| invalid(format!("{what}: out of memory for {count} pixels")))?;
     let float = |b: &[u8]| f32::from_ne_bytes([b[0], b[1], b[2], b[3]]);
-    Ok(bytes.chunks_exact(12).map(|c| Vec3::new(float(&c[0..4]), float(&c[4..8]), float(&c[8..12]))).collect())
+    pixels.extend(bytes.chunks_exact(12).map(|c| Vec3::new(float(&c[0..4]), float(&c[4..8]), float(&c[8..12]))));
+    Ok(pixels)
 }

@@ -12,6 +12,7 @@ use lumiere::materials::Material;
 use lumiere::math::UvTransform;
 use lumiere::render::fingerprint::scene_fingerprint;
 use lumiere::scene::Scene;
+use lumiere::scene::load::memory::{MeshSize, check_arrays_memory};
 use lumiere::scene::mesh::TriangleMesh;
 use lumiere::world::World;
 use pyo3::prelude::*;
@@ -97,6 +98,15 @@ impl PyScene {
         materials: Vec<MaterialSpec>,
         normals: Option<&[u8]>,
     ) -> PyResult<Self> {
+        // Refused before the copies below, which a scene too large for memory would abort in.
+        let size = MeshSize {
+            positions: positions.len() / 12,
+            texcoords: 0,
+            normals: normals.map_or(0, |n| n.len() / 12),
+            triangles: (indices.len() / 12) as u64,
+        };
+        let held = [positions, indices, material_ids, normals.unwrap_or_default()].iter().map(|b| b.len() as u64).sum();
+        check_arrays_memory(&name, size, held).or_py()?;
         // Copied while the GIL is held (the buffers are Python's), converted away from it.
         let arrays = Arrays {
             name,

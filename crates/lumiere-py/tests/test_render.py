@@ -590,3 +590,48 @@ def test_aovs_that_do_not_fit_beside_the_film_are_refused_before_rendering():
     child = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
     assert child.returncode == 0, child.stderr
     assert "image size 5000x4000 with its AOVs needs" in child.stdout, (child.stdout, child.stderr)
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="an address-space limit, as the CLI's tests use")
+def test_arrays_too_large_for_memory_are_refused_before_they_are_copied():
+    # 14M triangles need about 2.6 GB with their BVH: under a 2 GiB address-space limit, one line
+    # naming the need, as an OBJ of that size gets, not the allocator's abort of the interpreter.
+    script = textwrap.dedent(
+        """
+        import resource, numpy as np, lumiere
+        resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30))
+        vertices = np.random.default_rng(0).random((3000, 3), dtype=np.float32)
+        triangles = np.zeros((14_000_000, 3), dtype=np.uint32)
+        triangles[:, 1], triangles[:, 2] = 1, 2
+        try:
+            lumiere.Scene.from_arrays(vertices, triangles)
+        except lumiere.LumiereError as error:
+            print(error)
+        """
+    )
+    child = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert child.returncode == 0, child.stderr
+    assert "arrays: needs about" in child.stdout and "14000000 triangles" in child.stdout, (child.stdout, child.stderr)
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="an address-space limit, as the CLI's tests use")
+def test_an_image_too_large_to_encode_is_refused_and_the_old_file_kept(tmp_path):
+    # A 45-megapixel PFM under a 2 GiB address-space limit: the array, its bytes and the pixels
+    # leave no room for the file's 540 MB. An exception, not the allocator's abort of the interpreter.
+    target = tmp_path / "big.pfm"
+    target.write_bytes(b"old")
+    script = textwrap.dedent(
+        f"""
+        import resource, numpy as np, lumiere
+        resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30))
+        try:
+            lumiere.write_image({str(target)!r}, np.ones((11250, 4000, 3), np.float32))
+        except lumiere.LumiereError as error:
+            print(error)
+        """
+    )
+    child = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert child.returncode == 0, child.stderr
+    assert "out of memory" in child.stdout or "needs about" in child.stdout, (child.stdout, child.stderr)
+    assert target.read_bytes() == b"old"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["big.pfm"]

@@ -4,7 +4,7 @@
 //! a crash, a full disk or a killed process never leaves a half-written image where a previous good
 //! one used to be: readers see either the old file or the complete new one.
 
-use crate::error::shown_path;
+use crate::error::{shown_bytes, shown_path};
 use std::io::Cursor;
 use std::path::Path;
 use std::sync::OnceLock;
@@ -93,12 +93,49 @@ const SUPPORTED: &str = ".png, .exr, .pfm";
 pub fn write_image(path: &Path, width: u32, height: u32, pixels: &[Vec3], png: impl Into<PngStyle>) -> Result<()> {
     let format = format_of(path)?;
     check_dimensions(width, height, pixels.len())?;
+    check_encoding_memory(path, width, height, format.encoding_bytes_per_pixel())?;
     let bytes = match format {
         Format::Png => encode_png(path, width, height, pixels, png.into())?,
         Format::Exr => encode_exr(path, width, height, pixels)?,
-        Format::Pfm => encode_pfm(width, height, pixels),
+        Format::Pfm => encode_pfm(path, width, height, pixels)?,
     };
     write_atomically(path, &bytes)
+}
+
+impl Format {
+    /// The most an encoder holds at once per pixel, besides the pixels: the PFM's file; the PNG's
+    /// 8-bit values and its compressed stream (deflate's stored blocks at worst: 3 bytes and a
+    /// little); the EXR's file (12 bytes uncompressed at worst), which its buffer may double while
+    /// it grows, and its blocks on the way.
+    fn encoding_bytes_per_pixel(self) -> u64 {
+        match self {
+            Format::Pfm => 12,
+            Format::Png => 8,
+            Format::Exr => 40,
+        }
+    }
+}
+
+/// Refuses, before encoding, an image whose encoding (`bytes_per_pixel`) would not fit in the
+/// memory left: an error naming it, not the allocator's abort (a renderer's film was checked
+/// before its render, but an image written from Python, or after other processes took the
+/// memory, was not).
+fn check_encoding_memory(path: &Path, width: u32, height: u32, bytes_per_pixel: u64) -> Result<()> {
+    // Reading the memory left costs three /proc files: not worth it for small images.
+    const UNCHECKED_BYTES: u128 = 16 << 20;
+    let needed = width as u128 * height as u128 * bytes_per_pixel as u128;
+    let Some(available) = crate::util::read::available_memory().filter(|_| needed >= UNCHECKED_BYTES) else {
+        return Ok(());
+    };
+    if needed <= available as u128 {
+        return Ok(());
+    }
+    Err(Error::invalid(format!(
+        "{}: encoding a {width}x{height} image needs about {} of memory, but only {} is available",
+        shown_path(path),
+        shown_bytes(needed),
+        shown_bytes(available)
+    )))
 }
 
 /// Checks before a long render that `path` has a supported extension and its directory exists and is writable
@@ -284,6 +321,9 @@ pub fn write_exr_with_layers(path: &Path, width: u32, height: u32, pixels: &[Vec
         return Err(Error::invalid(format!("{}: extra layers (AOVs) need an .exr output", shown_path(path))));
     }
     check_dimensions(width, height, pixels.len())?;
+    // Each layer's channels are copied out of their pixels before the file is encoded.
+    let copies = 12 * (1 + layers.len() as u64);
+    check_encoding_memory(path, width, height, Format::Exr.encoding_bytes_per_pixel() + copies)?;
     let main = ExrLayer { name: "", channels: &["R", "G", "B"], pixels };
     let mut channels = Vec::new();
     for layer in std::iter::once(&main).chain(layers) {
@@ -303,14 +343,19 @@ pub fn write_exr_with_layers(path: &Path, width: u32, height: u32, pixels: &[Vec
 }
 
 /// Portable Float Map: a negative scale means little-endian, and scanlines run bottom to top.
-fn encode_pfm(width: u32, height: u32, pixels: &[Vec3]) -> Vec<u8> {
+fn encode_pfm(path: &Path, width: u32, height: u32, pixels: &[Vec3]) -> Result<Vec<u8>> {
     let header = format!("PF\n{width} {height}\n-1.0\n");
-    let mut bytes = Vec::with_capacity(header.len() + pixels.len() * 12);
+    let size = header.len() + pixels.len() * 12;
+    let mut bytes = Vec::new();
+    bytes.try_reserve_exact(size).map_err(|_| {
+        let message = format!("{}: out of memory for the PFM's {}", shown_path(path), shown_bytes(size as u128));
+        Error::invalid(message)
+    })?;
     bytes.extend_from_slice(header.as_bytes());
     for row in pixels.chunks_exact(width as usize).rev() {
         for value in row.iter().flat_map(|p| p.to_array()) {
             bytes.extend_from_slice(&value.to_le_bytes());
         }
     }
-    bytes
+    Ok(bytes)
 }

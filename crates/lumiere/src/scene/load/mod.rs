@@ -1,6 +1,7 @@
 //! Scene files in: the loader is chosen by the file's extension, and every loader hands its
 //! triangles, materials and warnings to [`Scene::from_parts`]. Loaders know nothing of rendering.
 
+pub mod memory;
 pub mod obj;
 pub mod warnings;
 

@@ -22,6 +22,7 @@ mod text;
 use crate::error::{Error, Result, shown_bytes, shown_path};
 use crate::materials::Material;
 use crate::scene::Scene;
+use crate::scene::load::memory::{Memory, MeshSize, check_mesh_memory};
 use crate::scene::mesh::{NO_INDEX, TriangleMesh};
 use crate::util::read;
 use chunk::{ChunkCounts, ChunkMesh, ChunkStart, Dropped, VertexCounts, parse_chunk};
@@ -52,35 +53,6 @@ impl ObjScene {
         let mut scene = Scene::from_parts(name, self.mesh, self.materials, self.warnings)?;
         scene.sources = self.material_files;
         Ok(scene)
-    }
-}
-
-/// Bytes per triangle that `World::new` adds to the mesh: the BVH (about 80 bytes per triangle)
-/// and the temporaries of its build, at their peak. Measured on the 1.1M-triangle bunny with
-/// `/usr/bin/time -v lumiere render stanford-bunny-1m.obj.gz --size 8x6 --mode hits` (2 threads):
-/// 194 MB maximum resident, less 5 MB for the process and 24.5 MB for the mesh, is 148 bytes per
-/// triangle; rounded up. (Loading alone peaks at 92 MB: the 45 MB of text and twice the mesh.)
-const BVH_BYTES_PER_TRIANGLE: u64 = 160;
-
-/// Scenes estimated below this are not checked against the free memory (reading it costs three
-/// /proc files, and fuzzing parses millions of tiny files).
-const UNCHECKED_BYTES: u64 = 16 << 20;
-
-/// The memory a load may use: the system's (see [`read::available_memory`]) or, for tests, given.
-#[derive(Clone, Copy, Debug)]
-enum Memory {
-    System,
-    Given(u64),
-}
-
-impl Memory {
-    /// The bytes available when a load needs `needed`; `None` when it need not be checked.
-    fn available(self, needed: u64) -> Option<u64> {
-        match self {
-            Memory::System if needed < UNCHECKED_BYTES => None,
-            Memory::System => read::available_memory(),
-            Memory::Given(bytes) => Some(bytes),
-        }
     }
 }
 
@@ -170,7 +142,9 @@ fn parse_obj_within(
     let counts: Vec<ChunkCounts> = chunks.par_iter().map(|chunk| ChunkCounts::of(chunk)).collect();
     let (starts, totals) = chunk_starts(&counts);
     let triangles = counts.iter().map(|count| count.triangles as u64).sum();
-    check_memory(totals, triangles, name, memory)?;
+    let size =
+        MeshSize { positions: totals.positions, texcoords: totals.texcoords, normals: totals.normals, triangles };
+    check_mesh_memory(name, size, 0, memory, "mesh and BVH")?;
     let parsed: Vec<Result<ChunkMesh>> = (chunks.par_iter().zip(&counts).zip(starts))
         .map(|((chunk, counts), start)| parse_chunk(chunk, counts, start, totals, name))
         .collect();
@@ -194,35 +168,6 @@ fn parse_obj_within(
         warnings,
         material_files: table.files,
     })
-}
-
-/// The memory the mesh of `vertices` and `triangles` needs while it is parsed and then rendered:
-/// parsing holds the chunks' vectors and their concatenation at once; rendering holds the mesh
-/// and the BVH. The text itself is already in memory.
-fn estimated_bytes(vertices: VertexCounts, triangles: u64) -> u64 {
-    let count = |n: usize| n as u64;
-    let vertex_bytes = 12 * count(vertices.positions) + 8 * count(vertices.texcoords) + 12 * count(vertices.normals);
-    // Position indices and material id, and attribute indices when the file has such attributes.
-    let per_triangle = 12 + 4 + 12 * u64::from(vertices.texcoords > 0) + 12 * u64::from(vertices.normals > 0);
-    let mesh = vertex_bytes.saturating_add(per_triangle.saturating_mul(triangles));
-    mesh.saturating_mul(2).max(mesh.saturating_add(BVH_BYTES_PER_TRIANGLE.saturating_mul(triangles)))
-}
-
-/// Refuses, before anything is allocated, a scene whose mesh and BVH would not fit in memory.
-fn check_memory(vertices: VertexCounts, triangles: u64, name: &Path, memory: Memory) -> Result<()> {
-    let needed = estimated_bytes(vertices, triangles);
-    let Some(available) = memory.available(needed) else { return Ok(()) };
-    if needed <= available {
-        return Ok(());
-    }
-    let message = format!(
-        "needs about {} of memory for its {triangles} triangles and {} vertices (mesh and BVH), but only {} is \
-         available; refusing it",
-        shown_bytes(needed),
-        vertices.positions,
-        shown_bytes(available)
-    );
-    Err(Error::io(name, io::Error::new(io::ErrorKind::OutOfMemory, message)))
 }
 
 /// The text with its continued lines joined (`obj/continued.rs`), in a copy refused up front, as
