@@ -15,6 +15,17 @@ def test_a_clear_error_without_pyoidn(monkeypatch):
         lumiere.denoise(np.zeros((4, 4, 3), dtype=np.float32))
 
 
+def test_what_is_not_an_image_is_refused_before_pyoidn_is_needed(monkeypatch):
+    monkeypatch.setitem(sys.modules, "pyoidn", None)  # the checks come first: no pyoidn needed
+    for bad in (np.array([[[None] * 3]]), np.ones((2, 2, 3), complex), [[["1", "2", "3"]]]):
+        with pytest.raises(lumiere.LumiereError, match="color must hold numbers"):
+            lumiere.denoise(bad)
+    with pytest.raises(lumiere.LumiereError, match="albedo must hold numbers"):
+        lumiere.denoise(np.zeros((2, 2, 3)), np.full((2, 2, 3), None))
+    with pytest.raises(lumiere.LumiereError, match="quality must be one of high, balanced, fast, got 'bogus'"):
+        lumiere.denoise(np.zeros((2, 2, 3)), quality="bogus")
+
+
 def test_denoising_brings_a_noisy_render_closer_to_the_reference():
     optional("pyoidn", "pip install 'lumiere[denoise]'")
     scene = lumiere.builtin()

@@ -11,6 +11,9 @@ from .errors import LumiereError
 
 __all__ = ["denoise"]
 
+#: OIDN's filter qualities, best first.
+QUALITIES = ("high", "balanced", "fast")
+
 
 def _pyoidn() -> Any:
     try:
@@ -23,7 +26,13 @@ def _pyoidn() -> Any:
 
 
 def _image(value: Any, name: str, shape: Optional[tuple]) -> np.ndarray:
-    array = np.ascontiguousarray(value, dtype=np.float32)
+    values = np.asarray(value)
+    # Numbers only, as lumiere.write_image takes them: None would become NaN, a complex value
+    # would lose its imaginary part, and a string of digits would be read as a number.
+    if values.dtype.kind not in "buif":
+        raise LumiereError(f"{name} must hold numbers, got an array of {values.dtype}")
+    with np.errstate(over="ignore"):
+        array = np.ascontiguousarray(values, dtype=np.float32)
     if array.ndim != 3 or array.shape[2] != 3 or min(array.shape[:2]) == 0:
         raise LumiereError(f"{name} must have shape (height, width, 3), got {array.shape}")
     if shape is not None and array.shape != shape:
@@ -40,10 +49,11 @@ def denoise(color: Any, albedo: Any = None, normal: Any = None, *, quality: str 
     :param quality: ``high``, ``balanced`` or ``fast``.
     :raises ImportError: pyoidn is not installed (the message says how to install it).
     """
-    pyoidn = _pyoidn()
+    if quality not in QUALITIES:
+        raise LumiereError(f"quality must be one of {', '.join(QUALITIES)}, got {quality!r}")
     color = _image(color, "color", None)
     if normal is not None and albedo is None:
         raise LumiereError("normal needs albedo too (OIDN uses normals only with an albedo)")
     albedo = None if albedo is None else _image(albedo, "albedo", color.shape)
     normal = None if normal is None else _image(normal, "normal", color.shape)
-    return pyoidn.denoise(color, albedo, normal, hdr=True, quality=quality)
+    return _pyoidn().denoise(color, albedo, normal, hdr=True, quality=quality)
