@@ -98,6 +98,36 @@ fn the_pyoidn_lookup_runs_nothing_from_the_working_folder_and_gives_up() {
     assert!(text.contains("was not found"), "{text}");
 }
 
+/// A library that is a FIFO is refused at once: opening it waited for a writer forever, inside the
+/// dynamic loader, where not even a signal could end the process.
+#[cfg(unix)]
+#[test]
+fn a_library_that_is_a_fifo_is_refused_not_waited_on() {
+    let dir = TempDir::new("denoise-fifo");
+    let fifo = dir.path("libOpenImageDenoise.so.2");
+    assert!(Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+    let mut child = lumiere()
+        .args(["render", "--denoise", "--size", "8x6", "-o"])
+        .arg(dir.path("out.png"))
+        .env("OIDN_DIR", dir.path(""))
+        .env("LUMIERE_NO_PYOIDN", "1")
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > Duration::from_secs(20) {
+            child.kill().unwrap();
+            panic!("still waiting on the FIFO after {:?}", start.elapsed());
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let out = child.wait_with_output().unwrap();
+    let text = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{text}");
+    assert!(text.contains("libOpenImageDenoise.so.2: is a FIFO, not a regular file"), "{text}");
+}
+
 #[test]
 fn denoising_four_samples_comes_closer_to_the_converged_image() {
     let dir = TempDir::new("denoise-rmse");

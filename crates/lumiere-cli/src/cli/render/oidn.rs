@@ -74,6 +74,14 @@ impl Oidn {
     pub fn load() -> Result<Oidn> {
         let mut tried = Vec::new();
         for candidate in candidates() {
+            // A path (not a bare name for the system's search) must be a regular file: opening a
+            // FIFO would wait for a writer forever, inside the loader.
+            if candidate.components().count() > 1
+                && let Ok(metadata) = std::fs::metadata(&candidate)
+                && let Err(e) = lumiere::util::read::refuse_special(&metadata)
+            {
+                return Err(Error::invalid(format!("--denoise: cannot load {}: {e}", candidate.display())));
+            }
             // SAFETY: loading OIDN runs its initialisers, which only set up its own state; the
             // candidates are files named like OIDN's library (or that name on the system path).
             match unsafe { libloading::Library::new(&candidate) } {

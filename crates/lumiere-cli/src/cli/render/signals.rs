@@ -25,12 +25,12 @@ pub fn install() {
         if !RENDERING.load(Ordering::SeqCst) {
             output::note("interrupted while loading; nothing was written");
             lumiere::util::write::remove_in_flight();
-            std::process::exit(i32::from(EXIT_INTERRUPTED));
+            exit_at_once(i32::from(EXIT_INTERRUPTED));
         }
         if CANCEL.swap(true, Ordering::SeqCst) {
             // An image or checkpoint may be half-written to its temporary file: remove it first.
             lumiere::util::write::remove_in_flight();
-            std::process::exit(EXIT_AT_ONCE);
+            exit_at_once(EXIT_AT_ONCE);
         }
     }) {
         output::warn(format_args!("cannot catch Ctrl-C ({e}); an interruption will lose the render"));
@@ -40,4 +40,19 @@ pub fn install() {
 /// From now on a first signal stops the render cleanly instead of exiting.
 pub fn rendering_starts() {
     RENDERING.store(true, Ordering::SeqCst);
+}
+
+/// Ends the process from the handler's thread without running the exit handlers: the main thread
+/// may be inside the dynamic loader (opening the denoiser's library, which can take long), whose
+/// lock `exit` waits for to unload libraries, so a signal then hung the process for good. Nothing
+/// is left to flush: the render writes only to stderr, which is not buffered, and to files, which
+/// are whole or removed.
+fn exit_at_once(code: i32) -> ! {
+    #[cfg(unix)]
+    // SAFETY: `_exit` ends the process at once; no code of this process runs after it.
+    unsafe {
+        libc::_exit(code)
+    }
+    #[cfg(not(unix))]
+    std::process::exit(code)
 }
