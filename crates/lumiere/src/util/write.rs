@@ -1,7 +1,7 @@
 //! Outputs appear atomically (temporary file, fsync, rename) and are never half-written: readers see
 //! the old file or the complete new one. Temporary files are short-named, registered while in
-//! flight (so a process that must exit at once can remove them), and those of dead processes are
-//! cleaned up by the next run.
+//! flight (so a process that must exit at once can remove them), locked by their writer, and those
+//! that no writer holds any more are cleaned up by the next run.
 
 use crate::error::shown_path;
 use std::fs::{self, File, OpenOptions};
@@ -20,16 +20,24 @@ const TEMP_SUFFIX: &str = ".tmp";
 /// Temporary files being written now, by any thread of this process.
 static IN_FLIGHT: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
+/// Names tried for a temporary file before giving up: a name is taken only by a temporary that a
+/// killed process left behind under a pid this process now has (containers reuse theirs).
+const TEMP_ATTEMPTS: usize = 10_000;
+
+/// How long a temporary file must have gone unwritten before a run that finds it unlocked removes
+/// it: longer than the moments its writer holds it unlocked (between creating and locking it,
+/// between closing and renaming it), with room for the clocks of a network file system.
+const STALE_AFTER: std::time::Duration = std::time::Duration::from_secs(10);
+
 /// Writes `bytes` to `path` atomically. Refuses a `path` that exists and is not a regular file (a
 /// device, a FIFO): renaming over it would replace the node itself, `/dev/null` included.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
     let resolved = resolve_link(path)?;
     let path = resolved.as_deref().unwrap_or(path);
     check_target(path)?;
-    let temp = temp_path(path)?;
     // Created separately so that a failure here (missing directory, no permission) leaves nothing to
     // clean up, and so we never remove a file we did not create.
-    let file = create_new(&temp).map_err(|e| Error::io(path, e))?;
+    let (file, temp) = create_temp(path)?;
     register(&temp);
     let result = fill_and_rename(file, &temp, path, bytes).map_err(|e| {
         // Best effort: the error worth reporting is the one that made us give up.
@@ -45,9 +53,28 @@ pub fn check_writable(path: &Path) -> Result<()> {
     let resolved = resolve_link(path)?;
     let path = resolved.as_deref().unwrap_or(path);
     check_target(path)?;
-    let probe = temp_path(path)?;
-    create_new(&probe).map_err(|e| Error::io(path, e))?;
+    let (_, probe) = create_temp(path)?;
     fs::remove_file(&probe).map_err(|e| Error::io(&probe, e))
+}
+
+/// A new temporary file next to `path`, locked (see [`lock`]), and its name: the first name of
+/// [`temp_path`]'s that no file has.
+fn create_temp(path: &Path) -> Result<(File, PathBuf)> {
+    for _ in 0..TEMP_ATTEMPTS {
+        let temp = temp_path(path)?;
+        match create_new(&temp) {
+            Ok(file) => {
+                lock(&file);
+                return Ok((file, temp));
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+            Err(e) => return Err(Error::io(path, e)),
+        }
+    }
+    Err(Error::invalid(format!(
+        "{}: {TEMP_ATTEMPTS} names for a temporary file beside it are all taken; remove the .lumiere-*.tmp files there",
+        shown_path(path)
+    )))
 }
 
 /// Removes every temporary file this process is writing now. For a process about to exit at once
@@ -59,34 +86,63 @@ pub fn remove_in_flight() {
     }
 }
 
-/// Removes the temporary files that processes which no longer run left in `dir` (killed with
-/// SIGKILL in the middle of a write); returns how many. Where the system cannot tell whether a
-/// process runs (no `/proc`), nothing is removed.
+/// Removes the temporary files that writers left in `dir` (killed with SIGKILL in the middle of a
+/// write); returns how many. A writer holds a lock on its temporary file until it is renamed, so a
+/// file no process holds, unwritten for [`STALE_AFTER`], is abandoned, whatever its name's pid:
+/// pids say nothing across containers that share a folder, and a process may have the pid of the
+/// one that left the file. Where files cannot be locked (not Unix), nothing is removed.
 pub fn remove_stale_temporaries(dir: &Path) -> usize {
-    let proc = Path::new("/proc/self");
-    if !proc.exists() {
-        return 0;
-    }
     let Ok(entries) = fs::read_dir(if dir.as_os_str().is_empty() { Path::new(".") } else { dir }) else { return 0 };
     let mut removed = 0;
     for entry in entries.flatten() {
-        let name = entry.file_name();
-        let Some(pid) = name.to_str().and_then(temp_owner) else { continue };
-        let alive = Path::new("/proc").join(pid.to_string()).exists();
-        if !alive && entry.file_type().is_ok_and(|t| t.is_file()) && fs::remove_file(entry.path()).is_ok() {
+        let is_temp = entry.file_name().to_str().is_some_and(is_temp_name);
+        if is_temp && entry.file_type().is_ok_and(|t| t.is_file()) && remove_if_abandoned(&entry.path()) {
             removed += 1;
         }
     }
     removed
 }
 
-/// The pid in a temporary file's name `.lumiere-<pid>-<n>.tmp`, if it is one.
-fn temp_owner(name: &str) -> Option<u32> {
-    let middle = name.strip_prefix(TEMP_PREFIX)?.strip_suffix(TEMP_SUFFIX)?;
-    let (pid, n) = middle.split_once('-')?;
-    n.parse::<u64>().ok()?;
-    pid.parse().ok()
+/// Whether `name` is a temporary file's, `.lumiere-<pid>-<n>.tmp`.
+fn is_temp_name(name: &str) -> bool {
+    let Some(middle) = name.strip_prefix(TEMP_PREFIX).and_then(|m| m.strip_suffix(TEMP_SUFFIX)) else { return false };
+    middle.split_once('-').is_some_and(|(pid, n)| pid.parse::<u32>().is_ok() && n.parse::<u64>().is_ok())
 }
+
+/// Removes the temporary file `path` if no process holds its lock and it has gone unwritten for
+/// [`STALE_AFTER`]; the lock is held while it is removed, so no writer can take it meanwhile.
+#[cfg(unix)]
+fn remove_if_abandoned(path: &Path) -> bool {
+    use std::os::unix::fs::OpenOptionsExt;
+    use std::os::unix::io::AsRawFd;
+    let Ok(file) = OpenOptions::new().read(true).custom_flags(libc::O_NOFOLLOW | libc::O_NONBLOCK).open(path) else {
+        return false;
+    };
+    // SAFETY: flock on a descriptor this function owns; the lock goes with the descriptor.
+    if unsafe { libc::flock(file.as_raw_fd(), libc::LOCK_EX | libc::LOCK_NB) } != 0 {
+        return false;
+    }
+    let idle = file.metadata().and_then(|m| m.modified()).ok().and_then(|t| t.elapsed().ok());
+    idle.is_some_and(|idle| idle >= STALE_AFTER) && fs::remove_file(path).is_ok()
+}
+
+#[cfg(not(unix))]
+fn remove_if_abandoned(_: &Path) -> bool {
+    false
+}
+
+/// Takes the lock that tells [`remove_stale_temporaries`] a temporary file is being written; it
+/// lasts as long as `file` is open. Best effort: a file system without locks leaves the file to
+/// the age test alone.
+#[cfg(unix)]
+fn lock(file: &File) {
+    use std::os::unix::io::AsRawFd;
+    // SAFETY: flock on a descriptor `file` owns for as long as the call.
+    unsafe { libc::flock(file.as_raw_fd(), libc::LOCK_EX | libc::LOCK_NB) };
+}
+
+#[cfg(not(unix))]
+fn lock(_: &File) {}
 
 /// Where a symbolic link points: the file to replace is its target, never the link itself (a
 /// rename over `/dev/stdout` would replace the link). `None` when `path` is not a link; an error
@@ -162,7 +218,8 @@ fn unregister(temp: &Path) {
     IN_FLIGHT.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).retain(|t| t != temp);
 }
 
-/// `create_new` so that a stale file with the same name (a pid reused after a crash) is never clobbered.
+/// `create_new` so that a stale file with the same name (a pid reused after a crash) is never
+/// clobbered: [`create_temp`] tries the next name instead.
 fn create_new(path: &Path) -> std::io::Result<File> {
     OpenOptions::new().write(true).create_new(true).open(path)
 }

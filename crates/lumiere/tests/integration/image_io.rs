@@ -288,25 +288,50 @@ fn a_replaced_file_keeps_its_permissions() {
     assert_eq!(dir.entries(), ["image.bin"]);
 }
 
-/// Temporaries left by a process that no longer runs are removed; those of live processes and
-/// other files are kept.
+/// Temporaries that no writer holds and that have gone unwritten for a while are removed, whatever
+/// the pid in their names (a live one: this process's, as when a container reuses the pid of the run
+/// it replaced); those a writer holds, those written just now, and other files are kept.
+#[cfg(unix)]
 #[test]
-fn stale_temporaries_of_dead_processes_are_removed() {
+fn abandoned_temporaries_are_removed_whatever_their_pid() {
+    use std::os::unix::io::AsRawFd;
     let dir = TempDir::new("stale");
-    // pid 4194304 is above Linux's largest pid (2^22): no process can have it.
-    dir.write(".lumiere-4194304-0.tmp", "half");
-    dir.write(&format!(".lumiere-{}-7.tmp", std::process::id()), "mine, in flight");
-    dir.write(".lumiere-notapid-0.tmp", "not ours");
+    let aged = |name: &str| {
+        dir.write(name, "half");
+        let file = fs::File::options().write(true).open(dir.path(name)).unwrap();
+        file.set_modified(std::time::SystemTime::now() - std::time::Duration::from_secs(3600)).unwrap();
+        file
+    };
+    let mine = format!(".lumiere-{}-999999.tmp", std::process::id());
+    drop(aged(".lumiere-4194304-0.tmp"));
+    drop(aged(&mine));
+    // A writer elsewhere (another container's process, unknown here) still holds this one.
+    let held = aged(".lumiere-4194305-0.tmp");
+    // SAFETY: flock on a descriptor `held` owns; released when it is dropped below.
+    assert_eq!(unsafe { libc::flock(held.as_raw_fd(), libc::LOCK_EX | libc::LOCK_NB) }, 0);
+    dir.write(".lumiere-4194306-0.tmp", "written just now");
+    drop(aged(".lumiere-notapid-0.tmp"));
     dir.write("render.png", "kept");
-    let removed = remove_stale_temporaries(&dir.0);
-    let expected_removed = usize::from(Path::new("/proc/self").exists());
-    assert_eq!(removed, expected_removed);
-    if expected_removed == 1 {
-        let mine = format!(".lumiere-{}-7.tmp", std::process::id());
-        let mut expected = vec![".lumiere-notapid-0.tmp".to_string(), mine, "render.png".to_string()];
-        expected.sort();
-        assert_eq!(dir.entries(), expected);
+    assert_eq!(remove_stale_temporaries(&dir.0), 2);
+    let kept = [".lumiere-4194305-0.tmp", ".lumiere-4194306-0.tmp", ".lumiere-notapid-0.tmp", "render.png"];
+    assert_eq!(dir.entries(), kept);
+    drop(held);
+    assert_eq!(remove_stale_temporaries(&dir.0), 1, "no writer holds it any more");
+}
+
+/// Names of temporaries that a killed process left under this process's pid do not stop a write:
+/// the next free name is used, and the old files are left to the cleanup.
+#[test]
+fn a_write_takes_the_next_name_when_stale_temporaries_hold_its_own() {
+    let dir = TempDir::new("taken");
+    let pid = std::process::id();
+    for n in 0..2000 {
+        dir.write(&format!(".lumiere-{pid}-{n}.tmp"), "left by a killed run");
     }
+    let path = dir.path("out.bin");
+    write_atomically(&path, b"new").expect("a free name is found");
+    assert_eq!(fs::read(&path).unwrap(), b"new");
+    assert_eq!(dir.entries().len(), 2001, "the old files stay, nothing else is left");
 }
 
 #[test]
