@@ -257,7 +257,7 @@ pub fn check_obj(result: &lumiere::Result<ObjScene>, file: &Path, bytes: &[u8]) 
 }
 
 /// Checks an `Orbiter::parse(bytes, file)` result; an accepted orbiter must be finite and give a
-/// camera whose rays do not panic.
+/// camera whose rays are finite.
 pub fn check_orbiter(result: &lumiere::Result<Orbiter>, file: &Path, bytes: &[u8]) -> Result<(), String> {
     match result {
         Ok(orbiter) => {
@@ -270,6 +270,10 @@ pub fn check_orbiter(result: &lumiere::Result<Orbiter>, file: &Path, bytes: &[u8
                 && [fov, w, h].iter().all(|v| v.is_finite());
             if !finite {
                 return Err(format!("accepted a non-finite orbiter: {orbiter:?}"));
+            }
+            let ray = Camera::from_orbiter(orbiter, 8, 6).ray(4.0, 3.0);
+            if !(ray.origin.is_finite() && ray.dir.is_finite()) {
+                return Err(format!("accepted an orbiter whose rays are not finite ({ray:?}): {orbiter:?}"));
             }
             Ok(())
         }

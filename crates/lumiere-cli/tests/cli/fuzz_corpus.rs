@@ -444,6 +444,14 @@ fn orbiter_files_with_missing_lines_huge_numbers_or_nan_are_refused() {
         ("extra-number.txt", 1, "'c' expects 3 numbers, found 4"),
         ("unknown-field.txt", 5, "unknown orbiter field 'zoom'"),
         ("not-utf8.txt", 5, "not UTF-8"),
+        ("zero-radius.txt", 4, "'s' gives a radius of 0.0 at a distance of 2.78"),
+        ("tiny-radius.txt", 4, "'s' gives a radius of 1e-320 at a distance of 1.27"),
+        ("huge-finite.txt", 4, "the camera's rays are not finite"),
+        (
+            "huge-radius.txt",
+            4,
+            "the camera's rays are not finite: its numbers overflow, or its near and far planes (0.1 and 1e39",
+        ),
     ];
     for (file, line, needle) in cases {
         let path = Path::new(CORPUS).join("orbiter").join(file);

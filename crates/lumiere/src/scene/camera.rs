@@ -34,6 +34,7 @@ impl Orbiter {
     /// Parses orbiter text; `path` names the file in errors.
     pub fn parse(bytes: &[u8], path: &Path) -> Result<Orbiter> {
         let mut fields: [Option<Vec<f64>>; 5] = Default::default();
+        let mut size_line = 0;
         for (index, raw) in bytes.split(|&b| b == b'\n').enumerate() {
             let line = index + 1;
             let text = std::str::from_utf8(raw).map_err(|_| Error::parse(path, line, "not UTF-8 text"))?;
@@ -66,6 +67,9 @@ impl Orbiter {
                 ));
             }
             fields[slot] = Some(values);
+            if key == "s" {
+                size_line = line;
+            }
         }
         let total_lines = bytes.split(|&b| b == b'\n').count();
         let mut take = |slot: usize, key: &str| {
@@ -73,14 +77,35 @@ impl Orbiter {
         };
         let (c, p, r, s) = (take(0, "c")?, take(1, "p")?, take(2, "r")?, take(3, "s")?);
         let frame = fields[4].take().map(|f| (f[0], f[1], f[2]));
-        Ok(Orbiter {
+        let orbiter = Orbiter {
             center: DVec3::new(c[0], c[1], c[2]),
             pan: DVec2::new(p[0], p[1]),
             rotation: DVec2::new(r[0], r[1]),
             size: s[0],
             radius: s[1],
             frame,
-        })
+        };
+        // Finite numbers can still make a camera without rays: gKit's near and far planes meet
+        // where the radius is nothing beside the distance to the centre (its projection divides by
+        // their difference), planes too far apart or huge numbers overflow the matrices. Every
+        // pixel's ray would be NaN, the image black.
+        let (near, far) = orbiter.clip_planes();
+        if near.is_finite() && far <= near {
+            let message = format!(
+                "'s' gives a radius of {:?} at a distance of {near:?} from the centre: the near and far planes \
+                 meet, so the camera has no depth to cast rays through (gKit's orbiters keep the scene's radius there)",
+                orbiter.radius
+            );
+            return Err(Error::parse(path, size_line, message));
+        }
+        if !orbiter.casts_finite_rays() {
+            let message = format!(
+                "the camera's rays are not finite: its numbers overflow, or its near and far planes ({near:?} and \
+                 {far:?}, from the radius and the distance to the centre) are too far apart for its matrices"
+            );
+            return Err(Error::parse(path, size_line, message));
+        }
+        Ok(orbiter)
     }
 
     /// gKit's `Orbiter::view()`.
@@ -93,10 +118,24 @@ impl Orbiter {
 
     /// gKit's `Orbiter::projection(width, height, fov)`, near/far planes computed as gKit does.
     pub fn projection(&self, width: f64, height: f64, fov_degrees: f64) -> DMat4 {
-        let d = self.center.distance(DVec3::new(self.pan.x, self.pan.y, self.size));
-        let znear = (d - self.radius).max(0.1);
-        let zfar = (d + self.radius).max(1.0);
+        let (znear, zfar) = self.clip_planes();
         gl_perspective(fov_degrees, width / height, znear, zfar)
+    }
+
+    /// Whether the camera of this orbiter casts finite rays through the corners and the centre of
+    /// the picture (the aspect ratio scales them in x only).
+    fn casts_finite_rays(&self) -> bool {
+        let camera = Camera::from_orbiter(self, 4, 3);
+        [(0.0, 0.0), (4.0, 0.0), (0.0, 3.0), (4.0, 3.0), (2.0, 1.5)].iter().all(|&(x, y)| {
+            let ray = camera.ray(x, y);
+            ray.origin.is_finite() && ray.dir.is_finite() && ray.dir != Vec3::ZERO
+        })
+    }
+
+    /// The distances of the near and far planes, computed as gKit does.
+    fn clip_planes(&self) -> (f64, f64) {
+        let d = self.center.distance(DVec3::new(self.pan.x, self.pan.y, self.size));
+        ((d - self.radius).max(0.1), (d + self.radius).max(1.0))
     }
 }
 
