@@ -347,7 +347,7 @@ fn texture_options_and_file_names_with_spaces() {
 }
 
 /// MTL names keep their bytes: a Latin-1 name stays apart from its neighbour (each byte read as
-/// a Latin-1 character), a texture's file name is the bytes on disk, and a byte-order mark
+/// a Latin-1 character) and matches its UTF-8 spelling, a texture's file name is the bytes on disk, and a byte-order mark
 /// does not hide the first `newmtl`; a binary MTL costs one warning, not one per line.
 #[test]
 fn mtl_names_keep_their_bytes_and_binary_files_one_warning() {
@@ -363,6 +363,13 @@ fn mtl_names_keep_their_bytes_and_binary_files_one_warning() {
     let names: Vec<&str> = scene.materials.iter().map(|m| m.name.as_str()).collect();
     assert_eq!(names, ["caf\u{e9}", "caf\u{e8}"]);
     assert_eq!((material_of(&scene, 0).kd, material_of(&scene, 1).kd), (Vec3::X, Vec3::Z));
+    // Names are compared as text: a `usemtl` spelt in UTF-8 finds the material its MTL spells in
+    // Latin-1 (one of the files saved again by another editor), as a reader of the two would.
+    let mut utf8 = format!("mtllib m.mtl\n{SQUARE}").into_bytes();
+    utf8.extend_from_slice("usemtl caf\u{e9}\nf 1 2 3\n".as_bytes());
+    let scene = parse_obj(&utf8, Path::new("test.obj"), &read).expect("parses");
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    assert_eq!(material_of(&scene, 0).kd, Vec3::X);
     #[cfg(unix)]
     {
         use std::os::unix::ffi::OsStrExt;

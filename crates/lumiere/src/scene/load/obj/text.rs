@@ -59,8 +59,10 @@ pub(super) fn comment_start(line: &[u8]) -> Option<usize> {
 }
 
 /// A name as text: UTF-8 where it is valid, otherwise each byte read as Latin-1, as older
-/// exporters wrote names, so that two names whose bytes differ stay two names (a lossy decoding
-/// would make `caf\xe9` and `caf\xe8` one material).
+/// exporters wrote names. Two Latin-1 names whose bytes differ stay two names (a lossy decoding
+/// would make `caf\xe9` and `caf\xe8` one material), and a Latin-1 name is the same name as its
+/// UTF-8 spelling: names are compared as text, so an OBJ and an MTL saved in different encodings
+/// still agree on `café`.
 pub(super) fn text(bytes: &[u8]) -> Cow<'_, str> {
     match std::str::from_utf8(bytes) {
         Ok(text) => Cow::Borrowed(text),
