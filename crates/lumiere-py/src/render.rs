@@ -4,7 +4,7 @@
 use lumiere::render::aov::{Aov, render_aovs};
 use lumiere::render::film::{Film, check_memory};
 use lumiere::render::forecast::{NoiseForecast, shown_number};
-use lumiere::render::unlit::{Unlit, is_black, unlit};
+use lumiere::render::unlit::{Unlit, is_black, unlit, why_black};
 use lumiere::render::{Hooks, RenderStats, StopReason, render_progressive};
 use pyo3::prelude::*;
 use pyo3::types::{PyByteArray, PyDict};
@@ -79,7 +79,7 @@ pub fn render<'py>(
                 )));
             }
             if is_black(&output) {
-                warn("the image is black: no camera ray reached a lit surface; check the camera with mode='hits'".into());
+                warn(format!("the image is black: {} (mode='hits')", why_black(&options.technique)));
             }
             // Empty when cancelled: `watch::run` then raises, and nothing is returned.
             let buffers = if aovs.is_empty() {

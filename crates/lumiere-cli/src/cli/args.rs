@@ -341,8 +341,11 @@ fn parse_positive_f32(s: &str) -> Result<f32, String> {
 /// input or another file with the table, and a folder is refused before the benchmark runs.
 fn parse_json_path(s: &str) -> Result<PathBuf, String> {
     let path = PathBuf::from(s);
+    if path.is_dir() {
+        return Err(format!("{s:?} is a directory; expected a .json file name"));
+    }
     match path.extension() {
-        Some(extension) if extension.eq_ignore_ascii_case("json") && !path.is_dir() => Ok(path),
+        Some(extension) if extension.eq_ignore_ascii_case("json") => Ok(path),
         _ => Err(format!("expected a .json file name, got {s:?}")),
     }
 }

@@ -15,6 +15,8 @@ use super::output;
 
 pub fn run(args: &BenchSamplerArgs) -> Result<()> {
     let (width, height) = args.size;
+    // Refused before the table starts: the reference image is kept beside each render.
+    lumiere::render::film::check_memory(width, height, 12, " beside its reference image")?;
     let world = World::new(Scene::builtin()?, Default::default());
     let camera = Camera::from_orbiter(&builtin::cornell_orbiter()?, width, height);
     let render_image = |technique: fn(u32) -> Technique, samples, sampler, seed| -> Result<Image> {

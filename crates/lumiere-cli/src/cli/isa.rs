@@ -24,6 +24,8 @@ pub fn choose(flag: Option<Isa>) -> Result<Isa> {
         return Ok(isa);
     }
     match std::env::var(ENV) {
+        // Set but empty is unset, as for `OIDN_DIR` (`LUMIERE_ISA= lumiere ...` clears it).
+        Ok(name) if name.trim().is_empty() => Ok(Isa::detect()),
         Ok(name) => parse(&name).map_err(|why| Error::invalid(format!("{ENV}: {why}"))),
         Err(std::env::VarError::NotPresent) => Ok(Isa::detect()),
         Err(std::env::VarError::NotUnicode(_)) => Err(Error::invalid(format!("{ENV} is not valid UTF-8"))),

@@ -6,6 +6,7 @@ use std::path::Path;
 use std::process::{Command, Output};
 
 use crate::common::TempDir;
+use lumiere::accel::Isa;
 
 fn lumiere(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_lumiere")).args(args).output().expect("the binary runs")
@@ -289,6 +290,9 @@ fn isa_environment_variable_is_honoured_and_checked() {
     assert_eq!(isa_used(), "sse2");
     assert!(run("sse2", &["--isa", "portable"]).status.success(), "the flag wins");
     assert_eq!(isa_used(), "portable");
+    // Set but empty is unset: the widest ISA this CPU has.
+    assert!(run("", &[]).status.success());
+    assert_eq!(isa_used(), Isa::detect().name());
     let _ = fs::remove_file(&out);
     let refused = run("avx9000", &[]);
     assert_eq!(refused.status.code(), Some(2));

@@ -196,7 +196,10 @@ fn bad_outputs_and_counts_are_refused_before_the_work() {
         "--aov albedo is given twice",
     );
     fs::write(dir.path("scene.obj"), "v 0 0 0\n").unwrap();
+    fs::create_dir(dir.path("folder.json")).unwrap();
     for (args, expected) in [
+        (vec!["bench-bvh", "--scenes", "cornell", "--json", &dir.arg("folder.json")], "is a directory"),
+        (vec!["bench-sampler", "--size", "65536x65536"], "beside its reference image needs"),
         (vec!["bench", "--quick", "--json", &dir.arg("scene.obj")], "expected a .json file name"),
         (vec!["bench", "--repeats", "4294967296"], "from 1 to 1000"),
         (vec!["bench", "--repeats", "0"], "from 1 to 1000"),
@@ -531,7 +534,8 @@ fn a_camera_that_sees_nothing_says_so() {
         &dir.arg("o.png"),
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
-    assert!(stderr(&out).contains("the image is black"), "{}", stderr(&out));
+    // The hit mask is the check the other modes' warning points to: it says what it saw itself.
+    assert!(stderr(&out).contains("the image is black: no camera ray hit the scene"), "{}", stderr(&out));
 }
 
 /// A signal while a large scene loads exits at once with the documented code, writing nothing.

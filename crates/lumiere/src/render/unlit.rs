@@ -39,3 +39,12 @@ pub fn unlit(world: &World, technique: &Technique) -> Option<Unlit> {
 pub fn is_black(output: &RenderOutput) -> bool {
     output.film.samples > 0 && output.image.pixels.iter().all(|p| p.max_element() <= 0.0)
 }
+
+/// What a black image of `technique` says, for the warning: no camera ray hit anything in the hit
+/// mask, no camera ray reached a lit surface in the other modes (which the hit mask then checks).
+pub fn why_black(technique: &Technique) -> &'static str {
+    match technique {
+        Technique::Hits(_) => "no camera ray hit the scene; check where the camera looks",
+        _ => "no camera ray reached a lit surface; check the camera with the hits mode",
+    }
+}

@@ -201,8 +201,14 @@ impl Camera {
         let forward = (view / view.abs().max_element())
             .try_normalize()
             .ok_or_else(|| Error::invalid("camera: the eye and the target are the same point"))?;
-        let right = forward
-            .cross(up)
+        if !up.is_finite() {
+            return Err(Error::invalid(format!("camera: the up vector {up} must be finite")));
+        }
+        // A long but finite up vector overflows the cross product or its length: scaled then (only
+        // then, so that every other camera keeps its bits), as the view is.
+        let side = forward.cross(up);
+        let side = if side.length_squared().is_finite() { side } else { forward.cross(up / up.abs().max_element()) };
+        let right = side
             .try_normalize()
             .ok_or_else(|| Error::invalid("camera: the up vector is zero or parallel to the viewing direction"))?;
         if !(fov_degrees > 0.0 && fov_degrees < 180.0) {

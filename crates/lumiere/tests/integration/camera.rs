@@ -72,6 +72,12 @@ fn look_at_rejects_degenerate_frames() {
         let message = Camera::look_at(eye, target, Vec3::Y, 45.0, 10, 10).unwrap_err().to_string();
         assert!(message.ends_with("must be finite"), "{message}");
     }
+    let message = Camera::look_at(Vec3::ZERO, Vec3::Z, Vec3::splat(f32::NAN), 45.0, 10, 10).unwrap_err().to_string();
+    assert!(message.ends_with("must be finite"), "{message}");
+    // A long but finite up vector is an up vector, not "parallel" because its cross product overflowed.
+    let long_up = Camera::look_at(Vec3::ZERO, Vec3::Z, Vec3::splat(1e38), 45.0, 10, 10).expect("a camera");
+    let unit_up = Camera::look_at(Vec3::ZERO, Vec3::Z, Vec3::ONE, 45.0, 10, 10).unwrap();
+    assert!(long_up.ray(0.0, 0.0).dir.abs_diff_eq(unit_up.ray(0.0, 0.0).dir, 1e-6));
 }
 
 /// Many rays at once are the rays one at a time, bit for bit, for both projections: film corners,

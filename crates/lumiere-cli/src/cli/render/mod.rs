@@ -83,7 +83,7 @@ fn render(args: &RenderArgs, threads: usize, denoiser: Option<&oidn::Oidn>) -> R
     if output.film.samples == 0 {
         return nothing_rendered(args, &output);
     }
-    report::warn_if_black(&output);
+    report::warn_if_black(&output, &options.technique);
     write_output(args, &world, &camera, &options, &output, denoiser)?;
     // Its error (a full disk) comes after the image, the summary and the statistics are out.
     let checkpoint = args.checkpoint.as_ref().map(|path| fingerprints.save(path, &output.film, &output.stats));

@@ -8,7 +8,7 @@ use std::path::Path;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use lumiere::integrators::{AmbientOcclusion, Direct, Technique};
-use lumiere::render::unlit::{Unlit, is_black, unlit};
+use lumiere::render::unlit::{Unlit, is_black, unlit, why_black};
 use lumiere::render::{RenderOptions, RenderOutput};
 use lumiere::scene::camera::Camera;
 use lumiere::world::World;
@@ -132,8 +132,8 @@ pub fn warn_if_unlit(world: &World, options: &RenderOptions) {
 }
 
 /// Why an image came out black, said after rendering: no camera ray saw anything lit.
-pub fn warn_if_black(output: &RenderOutput) {
+pub fn warn_if_black(output: &RenderOutput, technique: &Technique) {
     if is_black(output) {
-        output::warn("the image is black: no camera ray reached a lit surface; check the camera with --mode hits");
+        output::warn(format_args!("the image is black: {} (--mode hits)", why_black(technique)));
     }
 }
