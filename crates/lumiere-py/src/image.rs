@@ -4,13 +4,13 @@
 
 use std::path::PathBuf;
 
-use lumiere::image_io::{PngEncoding, PngStyle, Tonemap, check_output_path, write_image as write};
-use lumiere::util::write::check_writable;
+use lumiere::image_io::{PngEncoding, PngStyle, Tonemap, check_output_path, encode_image};
+use lumiere::util::write::{check_writable, write_atomically};
 use pyo3::prelude::*;
 
 use crate::errors::{OrPyErr, invalid};
 use crate::pixels::from_bytes;
-use crate::pools;
+use crate::{pools, watch};
 
 /// Writes float32 RGB `pixels` (row 0 at the top) to `path`; the extension picks the format.
 #[pyfunction]
@@ -27,7 +27,14 @@ pub fn write_image(
     let style = png_style(exposure, tonemap)?;
     let pixels = from_bytes(pixels, width as usize * height as usize, "image")?;
     let pool = pools::for_work()?;
-    py.detach(|| pool.install(|| write(&path, width, height, &pixels, style))).or_py()
+    // Encoding a large image takes seconds: Ctrl-C gives it up, as it gives up a load, and the
+    // file stays as it was (the encoding ends in the background, its bytes dropped).
+    let target = path.clone();
+    let bytes = watch::abandonable(py, "an image's encoding", move || {
+        pool.install(|| encode_image(&target, width, height, &pixels, style))
+    })?
+    .or_py()?;
+    py.detach(|| write_atomically(&path, &bytes)).or_py()
 }
 
 /// Refuses, before a long render, an image output that [`write_image`] would refuse after it: a

@@ -51,7 +51,7 @@ impl PyScene {
     ) -> PyResult<Self> {
         let start = Instant::now();
         let pool = pools::for_work()?;
-        let (world, fingerprint, load_seconds, build_seconds) = watch::abandonable(py, move || {
+        let (world, fingerprint, load_seconds, build_seconds) = watch::abandonable(py, "a load", move || {
             pool.install(|| {
                 let mut scene = scene()?;
                 for (name, ke) in emission {

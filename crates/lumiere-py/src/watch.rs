@@ -78,15 +78,20 @@ pub fn run<T: Send + 'static>(
 /// that started it: a child forked meanwhile inherits the handles, not the threads.
 static LEFT_RUNNING: Mutex<(u32, Vec<JoinHandle<()>>)> = Mutex::new((0, Vec::new()));
 
-/// Runs `work`, which the library cannot stop part-way (loading a scene, building its BVH), on a
+/// Runs `work` (`what`, for messages), which the library cannot stop part-way (loading a scene,
+/// building its BVH, encoding an image), on a
 /// thread of its own while the calling thread sleeps without the GIL, waking every few
 /// milliseconds to check for signals: Ctrl-C raises `KeyboardInterrupt` at once, as it would in
 /// Python code, and the work runs to its end in the background, where its result is dropped.
 /// Work left running so is waited for (still answering Ctrl-C) before the next starts, so that
 /// interrupting a load again and again never piles up scenes in memory.
-pub fn abandonable<T: Send + 'static>(py: Python<'_>, work: impl FnOnce() -> T + Send + 'static) -> PyResult<T> {
+pub fn abandonable<T: Send + 'static>(
+    py: Python<'_>,
+    what: &'static str,
+    work: impl FnOnce() -> T + Send + 'static,
+) -> PyResult<T> {
     wait_for_work_left_running(py)?;
-    let mut worker = Worker::spawn("a load", work)?;
+    let mut worker = Worker::spawn(what, work)?;
     loop {
         if let Some(value) = worker.wait(py)? {
             return Ok(value);

@@ -412,6 +412,47 @@ def test_ctrl_c_stops_the_render_and_raises_keyboard_interrupt(tmp_path):
         child.kill()
 
 
+def test_ctrl_c_while_an_image_encodes_raises_at_once_and_writes_nothing(tmp_path):
+    # A 36-megapixel PNG of noise takes seconds to encode on one thread: Ctrl-C must not wait for
+    # it, and the file must keep its old bytes, even once the encoding left running has ended (the
+    # next write waits for it).
+    target, other = tmp_path / "big.png", tmp_path / "small.png"
+    target.write_bytes(b"old")
+    script = textwrap.dedent(
+        f"""
+        import signal, numpy as np, lumiere
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+        image = np.random.default_rng(0).random((6000, 6000, 3), dtype=np.float32)
+        try:
+            lumiere.write_image({str(target)!r}, image)
+            print("written", flush=True)
+        except KeyboardInterrupt:
+            print("KeyboardInterrupt", flush=True)
+        lumiere.write_image({str(other)!r}, image[:2, :2])
+        print(open({str(target)!r}, "rb").read() == b"old", flush=True)
+        """
+    )
+    env = dict(os.environ, RAYON_NUM_THREADS="1")
+    child = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True, env=env)
+    try:
+        threads = f"/proc/{child.pid}/task"
+        deadline = time.perf_counter() + 60
+        while not any(_thread_name(threads, task) == "lumiere-work" for task in _listed(threads)):
+            assert time.perf_counter() < deadline and child.poll() is None, "the encoding never started"
+            time.sleep(0.01)
+        time.sleep(0.3)
+        sent = time.perf_counter()
+        child.send_signal(signal.SIGINT)
+        assert child.stdout.readline().strip() == "KeyboardInterrupt"
+        waited = time.perf_counter() - sent
+        assert waited < 1.5, f"the interrupt waited {waited:.2f} s for the encoding"
+        assert child.stdout.readline().strip() == "True", "the interrupted write replaced the file"
+        assert child.wait(timeout=60) == 0
+    finally:
+        child.kill()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["big.png", "small.png"]
+
+
 def test_ctrl_c_while_a_scene_builds_raises_keyboard_interrupt_at_once():
     # A BVH build cannot stop part-way: it ends in the background, unused, while Python goes on;
     # the next load waits for it, so that interrupted builds never pile up. Three million

@@ -91,15 +91,26 @@ const SUPPORTED: &str = ".png, .exr, .pfm";
 /// is renamed over `path` only after a complete write (and fsync of the file); on any failure the temporary
 /// file is removed and `path` is untouched.
 pub fn write_image(path: &Path, width: u32, height: u32, pixels: &[Vec3], png: impl Into<PngStyle>) -> Result<()> {
+    write_atomically(path, &encode_image(path, width, height, pixels, png)?)
+}
+
+/// The bytes [`write_image`] writes to `path`, without writing them: for a caller that may give
+/// up while a large image encodes (Python's Ctrl-C), leaving the file as it was.
+pub fn encode_image(
+    path: &Path,
+    width: u32,
+    height: u32,
+    pixels: &[Vec3],
+    png: impl Into<PngStyle>,
+) -> Result<Vec<u8>> {
     let format = format_of(path)?;
     check_dimensions(width, height, pixels.len())?;
     check_encoding_memory(path, width, height, format.encoding_bytes_per_pixel())?;
-    let bytes = match format {
-        Format::Png => encode_png(path, width, height, pixels, png.into())?,
-        Format::Exr => encode_exr(path, width, height, pixels)?,
-        Format::Pfm => encode_pfm(path, width, height, pixels)?,
-    };
-    write_atomically(path, &bytes)
+    match format {
+        Format::Png => encode_png(path, width, height, pixels, png.into()),
+        Format::Exr => encode_exr(path, width, height, pixels),
+        Format::Pfm => encode_pfm(path, width, height, pixels),
+    }
 }
 
 impl Format {
