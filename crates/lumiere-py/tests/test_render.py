@@ -581,8 +581,10 @@ def test_a_render_that_comes_out_black_says_why(tmp_path):
     with pytest.warns(RuntimeWarning, match='no triangle of the emitting material "lamp" can emit'):
         lumiere.render(lumiere.load(str(flat), emission={"lamp": (1, 1, 1)}), camera, spp=1)
     away = lumiere.Camera.look_at((0, 1, 3.9), (0, 1, 10), size=(8, 6))
-    with pytest.warns(RuntimeWarning, match="the image is black: no camera ray reached a lit surface"):
+    with pytest.warns(RuntimeWarning, match="the image is black: no camera ray hit the scene"):
         lumiere.render(lumiere.builtin(), away, spp=1, mode="hits")
+    with pytest.warns(RuntimeWarning, match="the image is black: no camera ray reached a lit surface; check the camera with the hits mode"):
+        lumiere.render(lumiere.builtin(), away, spp=1, mode="path")
     # A lit render says nothing of the kind.
     with warnings.catch_warnings():
         warnings.simplefilter("error")
@@ -612,6 +614,17 @@ def test_arguments_found_by_a_hostile_sweep(tmp_path):
     # No materials for triangles that need one: named for what it is.
     with pytest.raises(lumiere.LumiereError, match="materials must name at least one material"):
         lumiere.Scene.from_arrays(vertices, [[0, 1, 2]], materials=[])
+    # The second sweep's: an empty list of triangles is no triangles (numpy reads it as floats);
+    # a dict of materials is not a list of their names; AOVs that are not a list are named so;
+    # a path that is not one says what a path must be.
+    assert lumiere.Scene.from_arrays(vertices, []).info()["triangles"] == 0
+    with pytest.raises(lumiere.LumiereError, match="materials must be a list of names or dicts"):
+        lumiere.Scene.from_arrays(vertices, [[0, 1, 2]], materials={"a": 1})
+    with pytest.raises(lumiere.LumiereError, match="aovs must be a list of names"):
+        lumiere.render(lumiere.builtin(), spp=1, size=(8, 6), aovs=3)
+    for call in (lambda: lumiere.load(None), lambda: lumiere.load(3), lambda: lumiere.write_image(None, vertices[None])):
+        with pytest.raises(TypeError, match="a path must be a str, bytes or os.PathLike, got"):
+            call()
 
 
 @pytest.mark.skipif(sys.platform != "linux", reason="an address-space limit, as the CLI's tests use")

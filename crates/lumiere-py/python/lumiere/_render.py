@@ -122,7 +122,10 @@ def render_full(
     # Checked now, not after the render's first pass: a callback that cannot be called.
     if progress is not None and not callable(progress):
         raise TypeError(f"progress must be callable as progress(done, total), got {type(progress).__name__}")
-    aovs = tuple(_text(aov, f"aovs[{index}]") for index, aov in enumerate(aovs))
+    try:
+        aovs = tuple(_text(aov, f"aovs[{index}]") for index, aov in enumerate(aovs))
+    except TypeError:
+        raise LumiereError(f"aovs must be a list of names (albedo, normal, depth), got {aovs!r}") from None
     # An EXR cannot hold a channel twice, and the CLI refuses it: so does this.
     twice = _first_repeat(aovs)
     if twice is not None:

@@ -81,7 +81,10 @@ def _text(value: Any, what: str) -> str:
 
 def _path(path: Any) -> str:
     """A path given as ``str``, ``bytes`` or ``os.PathLike``, as the ``str`` the native side takes."""
-    return os.fsdecode(os.fspath(path))
+    try:
+        return os.fsdecode(os.fspath(path))
+    except TypeError:
+        raise TypeError(f"a path must be a str, bytes or os.PathLike, got {type(path).__name__}") from None
 
 
 def _integer(value: Any, what: str, low: int, high: Optional[int] = None) -> int:
@@ -177,12 +180,15 @@ class Scene:
         if vertices.ndim != 2 or vertices.shape[1] != 3:
             raise LumiereError(f"vertices must have shape (N, 3), got {vertices.shape}")
         triangles = np.asarray(triangles)
+        if triangles.size == 0 and triangles.dtype.kind in "biuf":
+            # `[]` (numpy reads it as float64, shape (0,)): no triangles, a scene of vertices only.
+            triangles = np.zeros((0, 3), dtype=np.uint32)
         if triangles.ndim != 2 or triangles.shape[1] != 3 or not np.issubdtype(triangles.dtype, np.integer):
             raise LumiereError(f"triangles must be integers of shape (M, 3), got {triangles.dtype} {triangles.shape}")
         if triangles.size and (triangles.min() < 0 or triangles.max() >= len(vertices)):
             raise LumiereError(f"triangles index vertices 0..{len(vertices) - 1}, found {triangles.min()}..{triangles.max()}")
         triangles = _own_array(triangles, np.uint32, "triangles")
-        if isinstance(materials, (str, bytes)):
+        if isinstance(materials, (str, bytes, Mapping)):
             raise LumiereError(f"materials must be a list of names or dicts, got {materials!r}")
         if materials is not None:
             try:
