@@ -45,7 +45,7 @@ pub fn render_passes<'py>(
     let threads = unsigned(threads, "threads", max)? as usize;
     // Owned by the render's thread (see `watch::run`).
     let (world, camera, options) = (scene.world.clone(), camera.camera.clone(), options.options.clone());
-    let pool = pools::for_render(threads)?;
+    let pool = pools::for_render(py, threads)?;
     let total = u64::from(camera.width) * u64::from(camera.height) * u64::from(count);
     // Leaves no warnings: any stack level does.
     let passes = watch::run(py, Some(total), progress.as_ref(), 1, move |watch| {

@@ -25,12 +25,23 @@ struct Kept {
 /// CLI builds it. Only the last one is kept, so a notebook that tries one thread count after
 /// another does not pile up threads; a render still running on a replaced pool keeps it until it
 /// ends.
-pub fn for_render(threads: usize) -> PyResult<Arc<ThreadPool>> {
+pub fn for_render(py: Python<'_>, threads: usize) -> PyResult<Arc<ThreadPool>> {
     if threads > MAX_THREADS {
         return Err(invalid(format!("threads must be at most {MAX_THREADS}, got {threads}")));
     }
     static RENDER: Mutex<Option<Kept>> = Mutex::new(None);
-    kept(&RENDER, threads)
+    if let Some(pool) = reused(&RENDER, threads) {
+        return Ok(pool);
+    }
+    // Starting a thousand threads takes about half a second, and ending them as long: both
+    // without the GIL, so that other Python threads run meanwhile, and without the cache's lock,
+    // which a thread holding the GIL may be waiting for. Another render may start its own pool
+    // meanwhile; the last one made is kept.
+    let pool = Arc::new(py.detach(|| lumiere::util::threads::pool(threads)).or_py()?);
+    let kept = Kept { process: std::process::id(), threads, pool: pool.clone() };
+    let replaced = RENDER.lock().unwrap_or_else(|e| e.into_inner()).replace(kept);
+    py.detach(move || drop(replaced));
+    Ok(pool)
 }
 
 /// Runs `work` in the pool of the default thread count kept for the module's other work.
@@ -44,22 +55,38 @@ pub fn for_work() -> PyResult<Arc<ThreadPool>> {
     kept(&WORK, 0)
 }
 
-/// `cache`'s pool if it has `threads` workers and was started by this process, else a new one,
-/// kept in its place. A pool inherited from the parent of a fork is forgotten, never dropped:
-/// dropping it would wake threads that do not exist here.
+/// `cache`'s pool if it has `threads` workers and was started by this process (see [`reused`]),
+/// else a new one, kept in its place.
 fn kept(cache: &Mutex<Option<Kept>>, threads: usize) -> PyResult<Arc<ThreadPool>> {
+    if let Some(pool) = reused(cache, threads) {
+        return Ok(pool);
+    }
+    let pool = Arc::new(lumiere::util::threads::pool(threads).or_py()?);
+    *cache.lock().unwrap_or_else(|e| e.into_inner()) =
+        Some(Kept { process: std::process::id(), threads, pool: pool.clone() });
+    Ok(pool)
+}
+
+/// `cache`'s pool if it has `threads` workers and was started by this process. A pool inherited
+/// from the parent of a fork is taken out and forgotten, never dropped: dropping it would wake
+/// threads that do not exist here.
+fn reused(cache: &Mutex<Option<Kept>>, threads: usize) -> Option<Arc<ThreadPool>> {
     let process = std::process::id();
     let mut cache = cache.lock().unwrap_or_else(|e| e.into_inner());
     match cache.take() {
         Some(kept) if kept.process == process && kept.threads == threads => {
             let pool = kept.pool.clone();
             *cache = Some(kept);
-            return Ok(pool);
+            Some(pool)
         }
-        Some(kept) if kept.process != process => std::mem::forget(kept),
-        _ => {}
+        Some(kept) if kept.process != process => {
+            std::mem::forget(kept);
+            None
+        }
+        // Another count's pool: kept until its replacement is made (a render may still use it).
+        other => {
+            *cache = other;
+            None
+        }
     }
-    let pool = Arc::new(lumiere::util::threads::pool(threads).or_py()?);
-    *cache = Some(Kept { process, threads, pool: pool.clone() });
-    Ok(pool)
 }

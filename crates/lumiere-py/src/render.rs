@@ -40,7 +40,7 @@ pub fn render<'py>(
     if !aovs.is_empty() {
         check_memory(camera.width, camera.height, aovs.len() as u64 * 24 + 12, " with its AOVs").or_py()?;
     }
-    let pool = pools::for_render(threads)?;
+    let pool = pools::for_render(py, threads)?;
     let threads = pool.current_num_threads();
     let pixels = u64::from(camera.width) * u64::from(camera.height);
     let total = (options.spp != u32::MAX).then(|| pixels * u64::from(options.spp));
