@@ -37,6 +37,14 @@ fn rmse(a: &[f32], b: &[f32]) -> f64 {
     (sum / a.len() as f64).sqrt()
 }
 
+/// `lumiere render --denoise <extra> -o <image>` looking for OIDN in `oidn_dir` only.
+fn denoise_looking_in(oidn_dir: &Path, image: &Path, extra: &[&str]) -> Command {
+    let mut command = lumiere();
+    command.args(["render", "--denoise"]).args(extra).arg("-o").arg(image);
+    command.env("OIDN_DIR", oidn_dir).env("LUMIERE_NO_PYOIDN", "1");
+    command
+}
+
 #[test]
 fn denoise_without_oidn_fails_before_rendering() {
     let dir = TempDir::new("denoise-missing");
@@ -44,13 +52,8 @@ fn denoise_without_oidn_fails_before_rendering() {
     let image = dir.path("out.png");
     let start = Instant::now();
     // A render that would take minutes: the error must come before it.
-    let out = lumiere()
-        .args(["render", "--denoise", "--spp", "100000", "--size", "512x384", "-o"])
-        .arg(&image)
-        .env("OIDN_DIR", dir.path("empty"))
-        .env("LUMIERE_NO_PYOIDN", "1")
-        .output()
-        .unwrap();
+    let out =
+        denoise_looking_in(&dir.path("empty"), &image, &["--spp", "100000", "--size", "512x384"]).output().unwrap();
     let text = stderr(&out);
     assert_eq!(out.status.code(), Some(2), "{text}");
     assert_eq!(text.lines().count(), 1, "one line: {text}");
@@ -106,11 +109,7 @@ fn a_library_that_is_a_fifo_is_refused_not_waited_on() {
     let dir = TempDir::new("denoise-fifo");
     let fifo = dir.path("libOpenImageDenoise.so.2");
     assert!(Command::new("mkfifo").arg(&fifo).status().unwrap().success());
-    let mut child = lumiere()
-        .args(["render", "--denoise", "--size", "8x6", "-o"])
-        .arg(dir.path("out.png"))
-        .env("OIDN_DIR", dir.path(""))
-        .env("LUMIERE_NO_PYOIDN", "1")
+    let mut child = denoise_looking_in(&dir.path(""), &dir.path("out.png"), &["--size", "8x6"])
         .stderr(std::process::Stdio::piped())
         .spawn()
         .unwrap();
@@ -126,6 +125,19 @@ fn a_library_that_is_a_fifo_is_refused_not_waited_on() {
     let text = stderr(&out);
     assert_eq!(out.status.code(), Some(2), "{text}");
     assert!(text.contains("libOpenImageDenoise.so.2: is a FIFO, not a regular file"), "{text}");
+}
+
+/// A file that is not a library is named with the loader's reason, not only "dlopen failed".
+#[cfg(target_os = "linux")]
+#[test]
+fn a_library_that_cannot_be_loaded_is_named_with_the_reason() {
+    let dir = TempDir::new("denoise-not-a-library");
+    fs::write(dir.path("libOpenImageDenoise.so.2"), "not a library\n").unwrap();
+    let out = denoise_looking_in(&dir.path(""), &dir.path("out.png"), &["--size", "8x6"]).output().unwrap();
+    let text = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{text}");
+    assert_eq!(text.lines().count(), 1, "one line: {text}");
+    assert!(text.contains("dlopen failed (") && text.contains("libOpenImageDenoise.so.2: "), "{text}");
 }
 
 #[test]

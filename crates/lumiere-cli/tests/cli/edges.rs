@@ -391,6 +391,13 @@ fn a_field_of_view_too_narrow_to_frame_is_named() {
     fs::write(dir.path("t.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
     let args = ["render", &dir.arg("t.obj"), "--fov", "1e-40", "--size", "8x6", "-o", &dir.arg("o.png")];
     assert_refused(&dir, &args, "a field of view of 1e-40 degrees is too narrow to frame it; give --eye and --target");
+    // Framed from a finite distance, but one at which single precision sees nothing (a black image).
+    let args = ["render", &dir.arg("t.obj"), "--fov", "1e-30", "--size", "8x6", "-o", &dir.arg("o.png")];
+    assert_refused(&dir, &args, "a field of view of 1e-30 degrees is too narrow to frame it");
+    let args =
+        ["render", &dir.arg("t.obj"), "--fov", "0.01", "--mode", "hits", "--size", "8x6", "-o", &dir.arg("o.png")];
+    let out = lumiere().args(args).output().unwrap();
+    assert!(out.status.success() && !stderr(&out).contains("black"), "{}", stderr(&out));
 }
 
 #[test]
@@ -445,15 +452,21 @@ fn flags_that_do_nothing_are_warned() {
         "power",
         "--fov",
         "30",
+        "--sampler",
+        "sobol",
         "-o",
         &dir.arg("o.png"),
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
     let message = stderr(&out);
-    for flag in ["--samples", "--ao-distance", "--light-sampling", "--fov"] {
+    for flag in ["--samples", "--ao-distance", "--light-sampling", "--fov", "--sampler"] {
         assert!(message.contains(&format!("warning: {flag} has no effect")), "{flag}: {message}");
     }
     assert!(!message.contains("--up"), "{message}");
+    // Jittered passes draw numbers: the sampler then matters in every mode.
+    let jittered = format!("render --size 8x6 --mode hits --spp 2 --sampler sobol -o {}", dir.arg("o.png"));
+    let out = run(&jittered.split(' ').collect::<Vec<_>>());
+    assert!(out.status.success() && !stderr(&out).contains("--sampler"), "{}", stderr(&out));
 
     // The PNG's flags on a linear output, --up on the built-in scene's orbiter, and a checkpoint
     // period without a checkpoint.

@@ -314,7 +314,10 @@ pub fn framing(bounds: &Aabb, fov_degrees: f32) -> std::result::Result<(Vec3, Ve
     let radius = 0.5 * bounds.extent().length();
     let distance = radius / (0.5 * fov_degrees.to_radians()).sin();
     let target = bounds.center();
-    if radius.is_finite() && target.is_finite() && !distance.is_finite() {
+    // Beyond this many radii away, single precision places the rays within more than 1/2^7 of the
+    // radius: a field of view under about 0.002 degrees, whose view is black or noise.
+    const MAX_DISTANCE_IN_RADII: f32 = 65536.0;
+    if radius.is_finite() && target.is_finite() && (distance.is_nan() || distance > MAX_DISTANCE_IN_RADII * radius) {
         return Err(format!("a field of view of {fov_degrees:?} degrees is too narrow to frame it"));
     }
     let eye = target + Vec3::Z * distance.max(1e-6);

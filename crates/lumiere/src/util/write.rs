@@ -110,7 +110,8 @@ fn is_temp_name(name: &str) -> bool {
 }
 
 /// Removes the temporary file `path` if no process holds its lock and it has gone unwritten for
-/// [`STALE_AFTER`]; the lock is held while it is removed, so no writer can take it meanwhile.
+/// [`STALE_AFTER`]. A live writer holds the lock from the file's creation to its rename, so
+/// taking it means the writer is gone.
 #[cfg(unix)]
 fn remove_if_abandoned(path: &Path) -> bool {
     use std::os::unix::fs::OpenOptionsExt;

@@ -87,8 +87,10 @@ impl Oidn {
             match unsafe { libloading::Library::new(&candidate) } {
                 Ok(library) => return Oidn::with_library(library, &candidate),
                 Err(e) if Path::new(&candidate).exists() => {
+                    // libloading says "dlopen failed" and keeps the loader's reason as the source.
+                    let reason = std::error::Error::source(&e).map_or(String::new(), |why| format!(" ({why})"));
                     return Err(Error::invalid(format!(
-                        "--denoise: cannot load {}: {e}; reinstall it: {HOW_TO_GET}",
+                        "--denoise: cannot load {}: {e}{reason}; reinstall it: {HOW_TO_GET}",
                         candidate.display()
                     )));
                 }

@@ -77,6 +77,16 @@ pub fn ignored_flags(args: &RenderArgs) -> Vec<String> {
     check(args.light_sampling.is_some(), "--light-sampling", mode == ModeArg::Direct, "direct only");
     check(args.ao_distance.is_some(), "--ao-distance", mode == ModeArg::Ao, "ao only");
     check(args.max_depth.is_some(), "--max-depth", mode == ModeArg::Path, "path only");
+    // The lab's first three images trace one ray through each pixel's centre: no random number,
+    // unless passes are jittered (more than one camera sample, or a budget that runs passes).
+    let one_centred_pass = args.spp.is_none_or(|spp| spp == 1) && args.time.is_none() && args.noise.is_none();
+    let draws_numbers = !matches!(mode, ModeArg::Hits | ModeArg::Materials | ModeArg::Shadows) || !one_centred_pass;
+    check(
+        args.sampler.is_some(),
+        "--sampler",
+        draws_numbers,
+        "one ray through each pixel centre draws no random number",
+    );
     for (flag, given) in [("--fov", args.fov.is_some()), ("--up", args.up.is_some())] {
         if given && args.orbiter.is_some() {
             ignored.push(format!("{flag} has no effect with --orbiter (gKit's orbiter camera has its own)"));
