@@ -75,10 +75,10 @@ impl PyFilm {
     }
 
     /// Adds pass `sample`, which must be the next one.
-    fn add_pass(&mut self, sample: u32, values: &[u8], rays: u64) -> PyResult<()> {
+    fn add_pass(&mut self, py: Python<'_>, sample: u32, values: &[u8], rays: u64) -> PyResult<()> {
         let values = from_bytes(values, self.film.pixel_count(), &format!("pass {sample}"))?;
         let pass = PassSamples { sample, width: self.film.width, height: self.film.height, values, rays };
-        pools::install(|| self.film.add_pass(&pass))?.or_py()?;
+        pools::install(py, || self.film.add_pass(&pass))?.or_py()?;
         // A count this large is nonsense, but it must not wrap around to a small one.
         self.stats.rays = self.stats.rays.saturating_add(rays);
         Ok(())
@@ -119,7 +119,7 @@ impl PyFilm {
 
     /// The current estimate as float32 RGB bytes, row 0 at the top.
     fn image<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyByteArray>> {
-        to_bytearray(py, &pools::install(|| self.film.image())?.pixels)
+        to_bytearray(py, &pools::install(py, || self.film.image())?.pixels)
     }
 
     /// Saves the film as a checkpoint of the render of `scene`, `camera` and `options`: the
@@ -150,15 +150,21 @@ impl PyFilm {
             film: self.film.clone(),
             stats: self.stats,
         };
-        let pool = pools::for_work()?;
+        let pool = pools::for_work(py)?;
         py.detach(|| pool.install(|| checkpoint.save(&path))).or_py()
     }
 
     /// The film of a checkpoint, refused (naming what differs) unless it was rendered from the
     /// same scene and options.
     #[staticmethod]
-    fn load_checkpoint(path: PathBuf, scene: &PyScene, camera: &PyCamera, options: &PyOptions) -> PyResult<Self> {
-        let checkpoint = pools::install(|| Checkpoint::load(&path))?.or_py()?;
+    fn load_checkpoint(
+        py: Python<'_>,
+        path: PathBuf,
+        scene: &PyScene,
+        camera: &PyCamera,
+        options: &PyOptions,
+    ) -> PyResult<Self> {
+        let checkpoint = pools::install(py, || Checkpoint::load(&path))?.or_py()?;
         if checkpoint.scene_fingerprint != scene.fingerprint {
             return Err(invalid(format!(
                 "{}: cannot resume: the checkpoint was rendered from a different scene (geometry, materials or emission)",

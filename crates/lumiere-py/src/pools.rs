@@ -30,40 +30,36 @@ pub fn for_render(py: Python<'_>, threads: usize) -> PyResult<Arc<ThreadPool>> {
         return Err(invalid(format!("threads must be at most {MAX_THREADS}, got {threads}")));
     }
     static RENDER: Mutex<Option<Kept>> = Mutex::new(None);
-    if let Some(pool) = reused(&RENDER, threads) {
-        return Ok(pool);
-    }
-    // Starting a thousand threads takes about half a second, and ending them as long: both
-    // without the GIL, so that other Python threads run meanwhile, and without the cache's lock,
-    // which a thread holding the GIL may be waiting for. Another render may start its own pool
-    // meanwhile; the last one made is kept.
-    let pool = Arc::new(py.detach(|| lumiere::util::threads::pool(threads)).or_py()?);
-    let kept = Kept { process: std::process::id(), threads, pool: pool.clone() };
-    let replaced = RENDER.lock().unwrap_or_else(|e| e.into_inner()).replace(kept);
-    py.detach(move || drop(replaced));
-    Ok(pool)
+    kept(py, &RENDER, threads)
 }
 
-/// Runs `work` in the pool of the default thread count kept for the module's other work.
-pub fn install<T: Send>(work: impl FnOnce() -> T + Send) -> PyResult<T> {
-    Ok(for_work()?.install(work))
+/// Runs `work` in the pool of the default thread count kept for the module's other work (with the
+/// GIL held, as a method borrowing its object needs: another thread's call then waits for it).
+pub fn install<T: Send>(py: Python<'_>, work: impl FnOnce() -> T + Send) -> PyResult<T> {
+    Ok(for_work(py)?.install(work))
 }
 
 /// The pool of the default thread count kept for the module's other work (see [`install`]).
-pub fn for_work() -> PyResult<Arc<ThreadPool>> {
+pub fn for_work(py: Python<'_>) -> PyResult<Arc<ThreadPool>> {
     static WORK: Mutex<Option<Kept>> = Mutex::new(None);
-    kept(&WORK, 0)
+    kept(py, &WORK, 0)
 }
 
 /// `cache`'s pool if it has `threads` workers and was started by this process (see [`reused`]),
 /// else a new one, kept in its place.
-fn kept(cache: &Mutex<Option<Kept>>, threads: usize) -> PyResult<Arc<ThreadPool>> {
+///
+/// Starting a thousand threads takes about half a second, and ending them as long: both happen
+/// without the GIL, so that other Python threads run meanwhile, and without the cache's lock, which
+/// a thread holding the GIL may be waiting for. Another call may start its own pool meanwhile; the
+/// last one made is kept.
+fn kept(py: Python<'_>, cache: &Mutex<Option<Kept>>, threads: usize) -> PyResult<Arc<ThreadPool>> {
     if let Some(pool) = reused(cache, threads) {
         return Ok(pool);
     }
-    let pool = Arc::new(lumiere::util::threads::pool(threads).or_py()?);
-    *cache.lock().unwrap_or_else(|e| e.into_inner()) =
-        Some(Kept { process: std::process::id(), threads, pool: pool.clone() });
+    let pool = Arc::new(py.detach(|| lumiere::util::threads::pool(threads)).or_py()?);
+    let kept = Kept { process: std::process::id(), threads, pool: pool.clone() };
+    let replaced = cache.lock().unwrap_or_else(|e| e.into_inner()).replace(kept);
+    py.detach(move || drop(replaced));
     Ok(pool)
 }
 

@@ -50,7 +50,7 @@ impl PyScene {
         builtin: bool,
     ) -> PyResult<Self> {
         let start = Instant::now();
-        let pool = pools::for_work()?;
+        let pool = pools::for_work(py)?;
         let (world, fingerprint, load_seconds, build_seconds) = watch::abandonable(py, "a load", move || {
             pool.install(|| {
                 let mut scene = scene()?;

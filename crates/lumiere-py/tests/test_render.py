@@ -1,6 +1,7 @@
 """lumiere.render: shapes and types, the CLI's exact values, options, errors, progress, the GIL
 and Ctrl-C."""
 
+import contextlib
 import os
 import pickle
 import signal
@@ -432,24 +433,8 @@ def test_ctrl_c_while_an_image_encodes_raises_at_once_and_writes_nothing(tmp_pat
         print(open({str(target)!r}, "rb").read() == b"old", flush=True)
         """
     )
-    env = dict(os.environ, RAYON_NUM_THREADS="1")
-    child = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True, env=env)
-    try:
-        threads = f"/proc/{child.pid}/task"
-        deadline = time.perf_counter() + 60
-        while not any(_thread_name(threads, task) == "lumiere-work" for task in _listed(threads)):
-            assert time.perf_counter() < deadline and child.poll() is None, "the encoding never started"
-            time.sleep(0.01)
-        time.sleep(0.3)
-        sent = time.perf_counter()
-        child.send_signal(signal.SIGINT)
-        assert child.stdout.readline().strip() == "KeyboardInterrupt"
-        waited = time.perf_counter() - sent
-        assert waited < 1.5, f"the interrupt waited {waited:.2f} s for the encoding"
+    with _interrupted_at_work(script, "the encoding") as child:
         assert child.stdout.readline().strip() == "True", "the interrupted write replaced the file"
-        assert child.wait(timeout=60) == 0
-    finally:
-        child.kill()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["big.png", "small.png"]
 
 
@@ -477,23 +462,32 @@ def test_ctrl_c_while_a_scene_builds_raises_keyboard_interrupt_at_once():
         print(time.perf_counter() - start, flush=True)
         """
     )
+    with _interrupted_at_work(script, "the build") as child:
+        next_load = float(child.stdout.readline())
+        assert next_load > 0.3, f"the next load started beside the build left running ({next_load:.3f} s)"
+
+
+@contextlib.contextmanager
+def _interrupted_at_work(script, work):
+    """Runs `script` in a child process on one thread and sends it SIGINT 0.3 s after its
+    `lumiere-work` thread starts (not while numpy makes its arrays): the child must print
+    `KeyboardInterrupt` within 1.5 s. Yields the child for the checks after that, then expects it
+    to exit cleanly."""
     env = dict(os.environ, RAYON_NUM_THREADS="1")
     child = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True, env=env)
     try:
-        # Interrupted once the build's thread runs (not while numpy makes the arrays).
         threads = f"/proc/{child.pid}/task"
         deadline = time.perf_counter() + 60
         while not any(_thread_name(threads, task) == "lumiere-work" for task in _listed(threads)):
-            assert time.perf_counter() < deadline and child.poll() is None, "the build never started"
+            assert time.perf_counter() < deadline and child.poll() is None, f"{work} never started"
             time.sleep(0.01)
         time.sleep(0.3)
         sent = time.perf_counter()
         child.send_signal(signal.SIGINT)
         assert child.stdout.readline().strip() == "KeyboardInterrupt"
         waited = time.perf_counter() - sent
-        assert waited < 1.5, f"the interrupt waited {waited:.2f} s for the build"
-        next_load = float(child.stdout.readline())
-        assert next_load > 0.3, f"the next load started beside the build left running ({next_load:.3f} s)"
+        assert waited < 1.5, f"the interrupt waited {waited:.2f} s for {work}"
+        yield child
         assert child.wait(timeout=60) == 0
     finally:
         child.kill()

@@ -132,12 +132,8 @@ impl Format {
 /// before its render, but an image written from Python, or after other processes took the
 /// memory, was not).
 fn check_encoding_memory(path: &Path, width: u32, height: u32, bytes_per_pixel: u64) -> Result<()> {
-    // Reading the memory left costs three /proc files: not worth it for small images.
-    const UNCHECKED_BYTES: u128 = 16 << 20;
     let needed = width as u128 * height as u128 * bytes_per_pixel as u128;
-    let Some(available) = crate::util::read::available_memory().filter(|_| needed >= UNCHECKED_BYTES) else {
-        return Ok(());
-    };
+    let Some(available) = crate::util::read::available_for(needed) else { return Ok(()) };
     if needed <= available as u128 {
         return Ok(());
     }

@@ -156,6 +156,16 @@ pub fn gunzip(raw: &[u8], limit: u64) -> io::Result<Vec<u8>> {
     }
 }
 
+/// Requests smaller than this are not checked against the memory left ([`available_for`]):
+/// reading it costs three /proc files, and fuzzing parses millions of tiny files.
+const UNCHECKED_BYTES: u128 = 16 << 20;
+
+/// The memory this process can still get ([`available_memory`]), to check a request of `needed`
+/// bytes against; `None` for a request below 16 MiB, not worth the reading, or where it is unknown.
+pub fn available_for(needed: u128) -> Option<u64> {
+    if needed < UNCHECKED_BYTES { None } else { available_memory() }
+}
+
 /// Memory this process can still get: `MemAvailable` from /proc/meminfo, capped by what is left
 /// of the address-space limit (`ulimit -v`, from /proc/self/limits, less `VmSize` from
 /// /proc/self/status); `None` where neither is known.

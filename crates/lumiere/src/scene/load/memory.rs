@@ -15,10 +15,6 @@ use crate::util::read;
 /// triangle; rounded up. (Loading alone peaks at 92 MB: the 45 MB of text and twice the mesh.)
 const BVH_BYTES_PER_TRIANGLE: u64 = 160;
 
-/// Scenes estimated below this are not checked against the free memory (reading it costs three
-/// /proc files, and fuzzing parses millions of tiny files).
-const UNCHECKED_BYTES: u64 = 16 << 20;
-
 /// The memory a load may use: the system's (see [`read::available_memory`]) or, for tests, given.
 #[derive(Clone, Copy, Debug)]
 pub(crate) enum Memory {
@@ -30,8 +26,7 @@ impl Memory {
     /// The bytes available when a load needs `needed`; `None` when it need not be checked.
     pub(crate) fn available(self, needed: u64) -> Option<u64> {
         match self {
-            Memory::System if needed < UNCHECKED_BYTES => None,
-            Memory::System => read::available_memory(),
+            Memory::System => read::available_for(u128::from(needed)),
             Memory::Given(bytes) => Some(bytes),
         }
     }
