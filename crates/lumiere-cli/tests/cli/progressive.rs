@@ -78,6 +78,29 @@ fn noise_target_stops_early_with_the_error_reached() {
     assert!(fewer.unwrap().film.relative_error().unwrap() > 0.05);
 }
 
+/// A run killed after its last pass's checkpoint was written, but before it stopped, resumes to
+/// the film it had: a film that already meets the target gets no further pass.
+#[test]
+fn a_resumed_film_that_meets_its_noise_target_gets_no_further_pass() {
+    let (world, camera) = small_world();
+    let options =
+        RenderOptions { spp: 10_000, noise_target: Some(0.05), ..RenderOptions::new(Technique::ambient_occlusion(8)) };
+    let done = render(&world, &camera, &options, &|_| {}).unwrap();
+    assert_eq!(done.stop, StopReason::NoiseTarget);
+
+    let cancel = AtomicBool::new(false);
+    let mut passes = 0;
+    let mut pass_done = |_: &Film, _: &RenderStats| {
+        passes += 1;
+        Ok(())
+    };
+    let hooks = Hooks { progress: &|_| {}, pass_done: &mut pass_done, cancel: &cancel };
+    let resumed = render_progressive(&world, &camera, &options, done.film.clone(), done.stats, hooks).unwrap();
+    assert_eq!((resumed.stop, passes), (StopReason::NoiseTarget, 0));
+    assert_eq!(resumed.film, done.film);
+    assert_eq!(resumed.image, done.image);
+}
+
 #[test]
 fn time_budget_stops_after_the_crossing_pass_and_says_why() {
     let dir = TempDir::new("time");
