@@ -210,6 +210,14 @@ impl Film {
     /// pass order, so the bits do not depend on the thread count; `values` is left as it was.
     pub(crate) fn add_rendered(&mut self, values: &mut Vec<[f32; 3]>) -> Result<()> {
         debug_assert_eq!(values.len(), self.pixel_count());
+        // Asked before anything is added: a film is whole passes or nothing. Only a forged
+        // checkpoint gets here (no render asks for more passes than a u32 counts).
+        let Some(samples) = self.samples.checked_add(1) else {
+            return Err(Error::invalid(format!(
+                "a film of {} samples per pixel cannot take another pass",
+                self.samples
+            )));
+        };
         let discarded = match &mut self.accumulated {
             Accumulated::Nothing => {
                 let discarded = values.par_chunks_mut(CHUNK).map(keep_in_place).sum();
@@ -230,8 +238,8 @@ impl Film {
             }
             Accumulated::Sums { sum, sum_sq } => add_in_parallel(sum, sum_sq, values, None),
         };
-        self.discarded += discarded;
-        self.samples += 1;
+        self.discarded = self.discarded.saturating_add(discarded);
+        self.samples = samples;
         Ok(())
     }
 }

@@ -69,7 +69,9 @@ fn run_range<I: Integrator>(
     let sampler = Sampler::new(options.sampler, options.seed);
     let pixel_centre = options.samples_pixel_centres();
     let stop_now = || cancel.load(Ordering::Relaxed).then_some(StopReason::Interrupted);
-    let mut passes = Vec::with_capacity(samples.len());
+    // Grown pass by pass: a range of billions of passes (most of which a cancel will cut short)
+    // must not ask for their records up front.
+    let mut passes = Vec::new();
     for sample in samples {
         let pass = Pass { sampler: &sampler, sample, pixel_centre };
         let mut values = pass_buffer(camera.width, camera.height)?;

@@ -89,6 +89,22 @@ fn every_form_holds_the_bits_of_one_addition_per_pass() {
     }
 }
 
+/// A forged checkpoint can hold a film at the largest count: another pass is refused, and the film
+/// is left whole, where the count wrapped to a film of no samples (a black image, then a
+/// checkpoint that lumiere refused).
+#[test]
+fn a_film_at_the_largest_sample_count_refuses_another_pass() {
+    let mut film = Film::new(WIDTH, HEIGHT).unwrap();
+    film.add_pass(&pass(0)).unwrap();
+    film.add_pass(&pass(1)).unwrap();
+    film.samples = u32::MAX;
+    let before = film.clone();
+    let next = PassSamples { sample: u32::MAX, ..pass(2) };
+    let error = film.add_pass(&next).unwrap_err().to_string();
+    assert!(error.contains("cannot take another pass"), "{error}");
+    assert_eq!(film, before);
+}
+
 /// A checkpoint stores sums and second moments whatever the film's form: it loads as an equal
 /// film, which renders the same image and goes on the same way.
 #[test]

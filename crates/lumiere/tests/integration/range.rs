@@ -69,3 +69,15 @@ fn a_cancelled_range_returns_whole_passes_only() {
     let passes = render_pass_range(&world, &camera, &options, 0, 4, &|_| {}, &cancel).unwrap();
     assert!(passes.is_empty());
 }
+
+/// A range as long as a u32 counts asks for no memory up front: one cancelled at once returns
+/// nothing, where reserving its records aborted the process (Python's `render_passes`).
+#[test]
+fn a_range_of_billions_of_passes_reserves_nothing_up_front() {
+    let (world, camera) = cornell(8, 6);
+    let mut options = RenderOptions::new(Technique::Path(Path::default()));
+    options.spp = u32::MAX;
+    let cancel = AtomicBool::new(true);
+    let passes = render_pass_range(&world, &camera, &options, 0, u32::MAX - 1, &|_| {}, &cancel).unwrap();
+    assert!(passes.is_empty());
+}
