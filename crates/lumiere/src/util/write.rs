@@ -123,8 +123,14 @@ fn remove_if_abandoned(path: &Path) -> bool {
     if unsafe { libc::flock(file.as_raw_fd(), libc::LOCK_EX | libc::LOCK_NB) } != 0 {
         return false;
     }
-    let idle = file.metadata().and_then(|m| m.modified()).ok().and_then(|t| t.elapsed().ok());
-    idle.is_some_and(|idle| idle >= STALE_AFTER) && fs::remove_file(path).is_ok()
+    let Ok(metadata) = file.metadata() else { return false };
+    let idle = metadata.modified().ok().and_then(|t| t.elapsed().ok());
+    // The name must still be the file locked: removed and made again meanwhile (names repeat
+    // across containers), it would be another writer's live file.
+    use std::os::unix::fs::MetadataExt;
+    let same_file =
+        fs::symlink_metadata(path).is_ok_and(|now| (now.dev(), now.ino()) == (metadata.dev(), metadata.ino()));
+    idle.is_some_and(|idle| idle >= STALE_AFTER) && same_file && fs::remove_file(path).is_ok()
 }
 
 #[cfg(not(unix))]
@@ -133,8 +139,8 @@ fn remove_if_abandoned(_: &Path) -> bool {
 }
 
 /// Takes the lock that tells [`remove_stale_temporaries`] a temporary file is being written; it
-/// lasts as long as `file` is open. Best effort: a file system without locks leaves the file to
-/// the age test alone.
+/// lasts as long as `file` is open. Best effort: on a file system without locks the cleaner cannot
+/// take one either, and removes nothing there.
 #[cfg(unix)]
 fn lock(file: &File) {
     use std::os::unix::io::AsRawFd;
@@ -239,15 +245,23 @@ fn take_identity_of(file: &File, target: &Path) -> std::io::Result<()> {
         // away; anyone else's replacement is theirs, as a new file of theirs would be.
         let _ = std::os::unix::fs::fchown(file, Some(metadata.uid()), Some(metadata.gid()));
     }
+    // Only where they differ: a file system that refuses `fchmod` (some network and FUSE mounts)
+    // then still takes a replacement whose permissions are already right.
+    if file.metadata()?.permissions() == metadata.permissions() {
+        return Ok(());
+    }
     file.set_permissions(metadata.permissions())
 }
 
 /// Writes and fsyncs before renaming, so that the rename cannot publish a file whose data is still only
-/// in the page cache; the handle is closed before the rename, which Windows requires.
+/// in the page cache. On Unix the file stays open, its lock held, until it is renamed: a cleaner
+/// that found it unlocked after a slow fsync would take it for abandoned. Windows requires the
+/// handle closed before the rename (and has no cleaner).
 fn fill_and_rename(mut file: File, temp: &Path, path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     file.write_all(bytes)?;
     take_identity_of(&file, path)?;
     file.sync_all()?;
+    #[cfg(not(unix))]
     drop(file);
     fs::rename(temp, path)
 }
