@@ -428,6 +428,32 @@ fn mtllib_with_several_files_or_a_name_with_spaces() {
     assert_eq!(material_of(&spaced, 0).kd, Vec3::X);
 }
 
+/// An `mtllib` name is read as a texture's is: its bytes are the file's name (a Latin-1 name is
+/// found on disk, not its UTF-8 spelling), and a backslash is a folder separator, as Windows
+/// exporters write it; `\ ` still escapes a space. Both were names of files that did not exist.
+#[test]
+fn mtllib_names_are_bytes_and_backslashes_separate_folders() {
+    let dir = TempDir::new("mtllib-bytes");
+    std::fs::create_dir_all(dir.0.join("sub")).expect("mkdir");
+    dir.write("sub/scene.mtl", b"newmtl red\nKd 1 0 0\n");
+    dir.write("sub/my file.mtl", b"newmtl blue\nKd 0 0 1\n");
+    #[cfg(unix)]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        let latin1 = dir.0.join(std::ffi::OsStr::from_bytes(b"caf\xe9.mtl"));
+        std::fs::write(latin1, b"newmtl green\nKd 0 1 0\n").expect("write");
+    }
+    let mut obj = b"mtllib sub\\scene.mtl\nmtllib sub\\my\\ file.mtl\nmtllib caf\xe9.mtl\n".to_vec();
+    obj.extend_from_slice(
+        format!("{SQUARE}usemtl red\nf 1 2 3\nusemtl blue\nf 1 3 4\nusemtl green\nf 2 3 4\n").as_bytes(),
+    );
+    let scene = load_obj(&dir.write("scene.obj", &obj)).expect("load");
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    assert_eq!([0, 1].map(|t| material_of(&scene, t).kd), [Vec3::X, Vec3::Z]);
+    #[cfg(unix)]
+    assert_eq!(material_of(&scene, 2).kd, Vec3::Y);
+}
+
 #[test]
 fn gzipped_obj_loads_and_corrupt_gzip_fails() {
     let dir = TempDir::new("gz");

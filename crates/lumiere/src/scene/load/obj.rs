@@ -31,6 +31,7 @@ use rayon::prelude::*;
 use skipped::SkippedStatements;
 use std::io;
 use std::path::{Path, PathBuf};
+use text::{path_from_bytes, text};
 
 /// Chunk size for parallel parsing: large enough that per-chunk overhead is noise, small enough
 /// that a 45 MB file gives dozens of chunks to balance across cores.
@@ -80,14 +81,18 @@ fn load_obj_within(path: &Path, memory: Memory) -> Result<ObjScene> {
     let bytes = read::read_input_with_memory(path, given).map_err(|error| Error::io(path, error))?;
     let folder = path.parent().unwrap_or(Path::new(""));
     // `a.mtl`, `./a.mtl` and `.//a.mtl` are one file, and so is `x/../a.mtl` when it exists.
-    let lexical = |name: &str| folder.join(name).components().collect::<PathBuf>();
-    let locate = |name: &str| Some(std::fs::canonicalize(folder.join(name)).unwrap_or_else(|_| lexical(name)));
-    let read_mtl = |name: &str| {
-        let mtl = lexical(name);
+    let lexical = |name: &Path| folder.join(name).components().collect::<PathBuf>();
+    let locate = |name: &[u8]| {
+        let name = path_from_bytes(name.to_vec());
+        Some(std::fs::canonicalize(folder.join(&name)).unwrap_or_else(|_| lexical(&name)))
+    };
+    let read_mtl = |name: &[u8]| {
+        let name = path_from_bytes(name.to_vec());
+        let mtl = lexical(&name);
         match read::read_input(&mtl) {
             Ok(bytes) => Ok((bytes, mtl)),
             // The OBJ only knows the name; the warning should say where a relative one was looked for.
-            Err(error) if Path::new(name).is_relative() => {
+            Err(error) if name.is_relative() => {
                 let looked_in = if folder.as_os_str().is_empty() { Path::new(".") } else { folder };
                 Err(io::Error::new(error.kind(), format!("{error}; looked in {}", shown_path(looked_in))))
             }
@@ -98,7 +103,9 @@ fn load_obj_within(path: &Path, memory: Memory) -> Result<ObjScene> {
 }
 
 /// Parses OBJ text. `name` is used in error messages; `read_mtl(file_name)` returns the MTL file's
-/// bytes and the path it came from (for messages and for resolving `map_Kd`), or an I/O error.
+/// bytes and the path it came from (for messages and for resolving `map_Kd`), or an I/O error. It
+/// gets each name as text ([`text::text`]: Latin-1 where the bytes are not UTF-8), unescaped, with
+/// backslashes read as `/`; files on disk ([`load_obj`]) are found by the name's bytes.
 /// Each MTL file (by the path `read_mtl` returns) is read and warned about once.
 #[expect(clippy::type_complexity, reason = "the closure type is spelled out so callers see it in the docs")]
 pub fn parse_obj(
@@ -113,13 +120,15 @@ pub fn parse_obj(
 /// inputs and compare with a single chunk (`usize::MAX`).
 #[doc(hidden)]
 pub fn parse_obj_with_chunk_size(bytes: &[u8], name: &Path, read_mtl: ReadMtl, chunk_bytes: usize) -> Result<ObjScene> {
-    parse_obj_within(bytes, name, MtlSource { read: read_mtl, locate: &|_| None }, chunk_bytes, Memory::System)
+    let read = |name: &[u8]| read_mtl(&text(name));
+    parse_obj_within(bytes, name, MtlSource { read: &read, locate: &|_| None }, chunk_bytes, Memory::System)
 }
 
 /// [`parse_obj`] as if `available` bytes of memory were left (see [`load_obj_with_memory`]).
 #[doc(hidden)]
 pub fn parse_obj_with_memory(bytes: &[u8], name: &Path, read_mtl: ReadMtl, available: u64) -> Result<ObjScene> {
-    let source = MtlSource { read: read_mtl, locate: &|_| None };
+    let read = |name: &[u8]| read_mtl(&text(name));
+    let source = MtlSource { read: &read, locate: &|_| None };
     parse_obj_within(bytes, name, source, CHUNK_BYTES, Memory::Given(available))
 }
 

@@ -103,7 +103,8 @@ pub(super) struct MaterialSwitch<'a> {
 #[derive(Debug)]
 pub(super) struct MaterialLibrary<'a> {
     pub(super) line: usize,
-    pub(super) names: Cow<'a, str>,
+    /// The rest of the line, as bytes: file names are bytes on Unix.
+    pub(super) names: &'a [u8],
 }
 
 /// What a chunk defines, with vertex indices already absolute in the file.
@@ -217,7 +218,7 @@ impl<'a> ChunkParser<'a> {
             Some(b"f") => self.face(tokens, line_number)?,
             Some(b"usemtl") => self.use_material(tokens, line_number)?,
             Some(b"mtllib") => {
-                let names = tokens.remainder();
+                let names = tokens.remainder_bytes();
                 self.mesh.libraries.push(MaterialLibrary { line: line_number, names });
             }
             Some(keyword) if is_silent(keyword) => {}

@@ -10,17 +10,21 @@ use std::collections::{HashMap, HashSet};
 use std::io;
 use std::path::{Path, PathBuf};
 
-/// Reads an MTL file by the name an OBJ gives it; see [`super::parse_obj`].
+/// Reads an MTL file by the name an OBJ gives it, as text; see [`super::parse_obj`].
 pub(super) type ReadMtl<'r> = &'r dyn Fn(&str) -> io::Result<(Vec<u8>, PathBuf)>;
+
+/// Reads an MTL file by its name's bytes (file names are bytes on Unix), returning its bytes and
+/// the path they came from.
+pub(super) type ReadMtlBytes<'r> = &'r dyn Fn(&[u8]) -> io::Result<(Vec<u8>, PathBuf)>;
 
 /// Where the MTL files of an OBJ come from.
 #[derive(Clone, Copy)]
 pub(super) struct MtlSource<'r> {
-    pub(super) read: ReadMtl<'r>,
+    pub(super) read: ReadMtlBytes<'r>,
     /// The file a name resolves to, known before reading it (on the file system), so that a
     /// library named under many spellings (`a.mtl`, `./a.mtl`, `x/../a.mtl`) is read once. `None`
     /// where only reading tells (in-memory sources); the path the read returns is used then.
-    pub(super) locate: &'r dyn Fn(&str) -> Option<PathBuf>,
+    pub(super) locate: &'r dyn Fn(&[u8]) -> Option<PathBuf>,
 }
 
 /// Name of the material of faces that come before any `usemtl`.
@@ -47,7 +51,7 @@ enum Outcome {
 /// once, however many `mtllib` lines or spellings name it.
 struct Tried<'r> {
     source: MtlSource<'r>,
-    names: HashSet<String>,
+    names: HashSet<Vec<u8>>,
     paths: HashSet<PathBuf>,
 }
 
@@ -62,7 +66,7 @@ impl MaterialTable {
         let mut tried = Tried { source, names: HashSet::new(), paths: HashSet::new() };
         let mut lines = HashSet::new();
         for library in libraries {
-            if lines.insert(library.names.as_ref()) {
+            if lines.insert(library.names) {
                 table.load_library(library, obj, &mut tried);
             }
         }
@@ -72,9 +76,9 @@ impl MaterialTable {
     /// `mtllib` may list several files, or one file whose name has spaces, escaped (`my\ file.mtl`)
     /// or not: the whole line is tried as one name first, then each word.
     fn load_library(&mut self, library: &MaterialLibrary, obj: &Path, tried: &mut Tried) {
-        let whole = unescape(&library.names);
+        let whole = unescape(library.names);
         let Outcome::Failed(error) = self.try_library(&whole, tried) else { return };
-        let words = split_names(&library.names);
+        let words = split_names(library.names);
         if words.len() < 2 {
             return self.warn_unreadable(obj, library.line, &whole, &error);
         }
@@ -85,8 +89,8 @@ impl MaterialTable {
         }
     }
 
-    fn try_library(&mut self, name: &str, tried: &mut Tried) -> Outcome {
-        if !tried.names.insert(name.to_string()) {
+    fn try_library(&mut self, name: &[u8], tried: &mut Tried) -> Outcome {
+        if !tried.names.insert(name.to_vec()) {
             return Outcome::Done;
         }
         let located = (tried.source.locate)(name);
@@ -106,7 +110,7 @@ impl MaterialTable {
         }
     }
 
-    fn warn_unreadable(&mut self, obj: &Path, line: usize, name: &str, error: &io::Error) {
+    fn warn_unreadable(&mut self, obj: &Path, line: usize, name: &[u8], error: &io::Error) {
         self.warnings.push(obj, "unreadable material libraries", || {
             format!(
                 "{}:{line}: cannot read material library {} ({error}); its materials will be grey",
@@ -164,35 +168,35 @@ impl MaterialTable {
     }
 }
 
-/// The line with its escaped whitespace (`\ `) unescaped, as one file name.
-fn unescape(line: &str) -> String {
-    let mut name = String::with_capacity(line.len());
-    let mut chars = line.chars().peekable();
-    while let Some(c) = chars.next() {
-        match c {
-            '\\' if chars.peek().is_some_and(|next| next.is_ascii_whitespace()) => name.extend(chars.next()),
-            c => name.push(c),
-        }
-    }
-    name
+/// The line as one file name: escaped whitespace (`\ `) unescaped, and every other backslash read
+/// as `/`, as in texture statements (Windows exporters write `sub\scene.mtl`).
+fn unescape(line: &[u8]) -> Vec<u8> {
+    let mut names = names(line, false);
+    names.pop().unwrap_or_default()
 }
 
 /// The file names of an `mtllib` line: split at whitespace, except where a backslash escapes it
-/// (`my\ file.mtl` is `my file.mtl`, as Blender and 3ds Max write names with spaces). Other
-/// backslashes are kept as they are.
-fn split_names(line: &str) -> Vec<String> {
+/// (`my\ file.mtl` is `my file.mtl`, as Blender and 3ds Max write names with spaces); every other
+/// backslash is read as `/`.
+fn split_names(line: &[u8]) -> Vec<Vec<u8>> {
+    names(line, true)
+}
+
+/// The names of `line`, one for the whole line or one per word (`split`), unescaped.
+fn names(line: &[u8], split: bool) -> Vec<Vec<u8>> {
     let mut names = Vec::new();
-    let mut name = String::new();
-    let mut chars = line.chars().peekable();
-    while let Some(c) = chars.next() {
-        match c {
-            '\\' if chars.peek().is_some_and(|next| next.is_ascii_whitespace()) => name.extend(chars.next()),
-            c if c.is_ascii_whitespace() => {
+    let mut name = Vec::new();
+    let mut bytes = line.iter().copied().peekable();
+    while let Some(b) = bytes.next() {
+        match b {
+            b'\\' if bytes.peek().is_some_and(u8::is_ascii_whitespace) => name.extend(bytes.next()),
+            b'\\' => name.push(b'/'),
+            b if split && b.is_ascii_whitespace() => {
                 if !name.is_empty() {
                     names.push(std::mem::take(&mut name));
                 }
             }
-            c => name.push(c),
+            b => name.push(b),
         }
     }
     if !name.is_empty() {

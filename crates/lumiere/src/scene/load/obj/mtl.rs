@@ -2,7 +2,9 @@
 //! because a render with one wrong material is more useful than no render.
 
 use super::continued::{has_continuations, joined};
-use super::text::{LONE_CARRIAGE_RETURNS, Tokens, finite_f32, has_lone_carriage_returns, lines, quoted};
+use super::text::{
+    LONE_CARRIAGE_RETURNS, Tokens, finite_f32, has_lone_carriage_returns, lines, path_from_bytes, quoted,
+};
 use crate::error::{quote, shown_path};
 use crate::materials::{Material, MaterialKind};
 use crate::math::UvTransform;
@@ -365,18 +367,4 @@ fn take_values<'a>(
         return Err(format!("{keyword} {}: {problem}", quoted(option)));
     }
     Ok(values)
-}
-
-/// A file name from the MTL's bytes: as they are on Unix, where names are bytes; elsewhere as
-/// text (see [`super::text::text`]).
-fn path_from_bytes(bytes: Vec<u8>) -> PathBuf {
-    #[cfg(unix)]
-    {
-        use std::os::unix::ffi::OsStringExt;
-        PathBuf::from(std::ffi::OsString::from_vec(bytes))
-    }
-    #[cfg(not(unix))]
-    {
-        PathBuf::from(super::text::text(&bytes).into_owned())
-    }
 }
