@@ -7,11 +7,10 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use lumiere::render::RenderStats;
-use lumiere::render::checkpoint::{Checkpoint, differing_options};
+use lumiere::render::checkpoint::Checkpoint;
 use lumiere::render::film::{Film, PassSamples};
-use lumiere::render::fingerprint::options_description;
+use lumiere::render::fingerprint::{Fingerprints, Mismatch};
 use lumiere::render::render_pass_range;
-use lumiere::util::hash::hash_bytes;
 use pyo3::prelude::*;
 use pyo3::types::PyByteArray;
 
@@ -141,16 +140,9 @@ impl PyFilm {
                 film.width, film.height, camera_size.0, camera_size.1
             )));
         }
-        let description = options_description(&options.options, &camera.camera);
-        let checkpoint = Checkpoint {
-            scene_fingerprint: scene.fingerprint,
-            options_fingerprint: hash_bytes(description.as_bytes()),
-            seed: options.options.seed,
-            options: description,
-            film: self.film.clone(),
-            stats: self.stats,
-        };
-        let pool = pools::for_work(py)?;
+        let fingerprints = Fingerprints::new(scene.fingerprint, &options.options, &camera.camera);
+        let checkpoint = fingerprints.checkpoint(self.film.clone(), self.stats);
+        let pool = pools::for_background(py)?;
         py.detach(|| pool.install(|| checkpoint.save(&path))).or_py()
     }
 
@@ -164,23 +156,26 @@ impl PyFilm {
         camera: &PyCamera,
         options: &PyOptions,
     ) -> PyResult<Self> {
-        let checkpoint = pools::install(py, || Checkpoint::load(&path))?.or_py()?;
-        if checkpoint.scene_fingerprint != scene.fingerprint {
-            return Err(invalid(format!(
-                "{}: cannot resume: the checkpoint was rendered from a different scene (geometry, materials or emission)",
-                path.display()
-            )));
-        }
-        let description = options_description(&options.options, &camera.camera);
-        if checkpoint.options_fingerprint != hash_bytes(description.as_bytes())
-            || checkpoint.seed != options.options.seed
-        {
-            return Err(invalid(format!(
-                "{}: cannot resume: the checkpoint was rendered with other options: {}; only spp may change",
-                path.display(),
-                differing_options(&checkpoint.options, &description).join(", ")
-            )));
-        }
-        Ok(PyFilm { film: checkpoint.film, stats: checkpoint.stats })
+        // A file as large as its film, read without the GIL (a static method borrows nothing).
+        let pool = pools::for_background(py)?;
+        let checkpoint = py.detach(|| pool.install(|| Checkpoint::load(&path))).or_py()?;
+        let fingerprints = Fingerprints::new(scene.fingerprint, &options.options, &camera.camera);
+        let why = match fingerprints.mismatch(&checkpoint) {
+            None => return Ok(PyFilm { film: checkpoint.film, stats: checkpoint.stats }),
+            Some(Mismatch::Scene) => {
+                "the checkpoint was rendered from a different scene (geometry, materials, textures or emission)"
+                    .to_string()
+            }
+            Some(Mismatch::Options(differing)) => {
+                format!("the checkpoint was rendered with other options: {}; only spp may change", differing.join(", "))
+            }
+            Some(Mismatch::FilmSize { film, image }) => {
+                format!(
+                    "the checkpoint's film is {}x{}, but the camera's image is {}x{}",
+                    film.0, film.1, image.0, image.1
+                )
+            }
+        };
+        Err(invalid(format!("{}: cannot resume: {why}", path.display())))
     }
 }

@@ -26,7 +26,7 @@ pub fn write_image(
 ) -> PyResult<()> {
     let style = png_style(exposure, tonemap)?;
     let pixels = from_bytes(pixels, width as usize * height as usize, "image")?;
-    let pool = pools::for_work(py)?;
+    let pool = pools::for_background(py)?;
     // Encoding a large image takes seconds: Ctrl-C gives it up, as it gives up a load, and the
     // file stays as it was (the encoding ends in the background, its bytes dropped).
     let target = path.clone();

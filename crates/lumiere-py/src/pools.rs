@@ -1,5 +1,7 @@
 //! The rayon pools all of the module's library work runs in: renders in a pool of the thread count
-//! asked for, everything else (loads, BVH builds, films, image files) in one of the default count.
+//! asked for; work that a Ctrl-C may leave running in the background (loads, BVH builds, image
+//! encodings) in one of the default count; short calls on films in another, so that they never
+//! queue behind an abandoned load while holding the GIL.
 //! Never rayon's global pool, which a forked process could not replace: a process forked from one
 //! that had started pools (multiprocessing's `fork`, the default start method on Linux before
 //! Python 3.14) inherits them without their threads, and work handed to them waited forever. Each
@@ -33,26 +35,35 @@ pub fn for_render(py: Python<'_>, threads: usize) -> PyResult<Arc<ThreadPool>> {
     kept(py, &RENDER, threads)
 }
 
-/// Runs `work` in the pool of the default thread count kept for the module's other work (with the
-/// GIL held, as a method borrowing its object needs: another thread's call then waits for it).
+/// Runs `work` in the pool of the default thread count kept for short calls on films, with the
+/// GIL held, as a method borrowing its object needs (another thread's call then waits for it,
+/// where without the GIL it would find the object borrowed). Nothing long runs in that pool, so
+/// the GIL is not held for long: loads and encodings that a Ctrl-C leaves running use
+/// [`for_background`].
 pub fn install<T: Send>(py: Python<'_>, work: impl FnOnce() -> T + Send) -> PyResult<T> {
-    Ok(for_work(py)?.install(work))
+    static SHORT: Mutex<Option<Kept>> = Mutex::new(None);
+    Ok(kept(py, &SHORT, 0)?.install(work))
 }
 
-/// The pool of the default thread count kept for the module's other work (see [`install`]).
-pub fn for_work(py: Python<'_>) -> PyResult<Arc<ThreadPool>> {
-    static WORK: Mutex<Option<Kept>> = Mutex::new(None);
-    kept(py, &WORK, 0)
+/// The pool of the default thread count kept for work that may go on in the background after a
+/// Ctrl-C (loads, builds, image encodings: see [`crate::watch::abandonable`]) or that runs
+/// without the GIL (saving a checkpoint).
+pub fn for_background(py: Python<'_>) -> PyResult<Arc<ThreadPool>> {
+    static BACKGROUND: Mutex<Option<Kept>> = Mutex::new(None);
+    kept(py, &BACKGROUND, 0)
 }
 
-/// `cache`'s pool if it has `threads` workers and was started by this process (see [`reused`]),
-/// else a new one, kept in its place.
+/// `cache`'s pool if it has `threads` workers (0: as many as `RAYON_NUM_THREADS` asks for now, or
+/// one per core) and was started by this process (see [`reused`]), else a new one, kept in its
+/// place.
 ///
-/// Starting a thousand threads takes about half a second, and ending them as long: both happen
-/// without the GIL, so that other Python threads run meanwhile, and without the cache's lock, which
-/// a thread holding the GIL may be waiting for. Another call may start its own pool meanwhile; the
-/// last one made is kept.
+/// Starting a thousand threads takes about half a second: it happens without the GIL, so that
+/// other Python threads run meanwhile, and without the cache's lock, which a thread holding the
+/// GIL may be waiting for; so does dropping the pool replaced. Another call may start its own pool
+/// meanwhile; the last one made is kept.
 fn kept(py: Python<'_>, cache: &Mutex<Option<Kept>>, threads: usize) -> PyResult<Arc<ThreadPool>> {
+    // By the count it stands for, so that 0 follows `RAYON_NUM_THREADS` as a new pool would.
+    let threads = lumiere::util::threads::resolved(threads);
     if let Some(pool) = reused(cache, threads) {
         return Ok(pool);
     }

@@ -28,7 +28,7 @@ pub struct PyScene {
     /// The built-in scene, whose default camera is gKit's orbiter.
     #[pyo3(get)]
     pub builtin: bool,
-    /// The fingerprint checkpoints store: geometry and materials, emission included.
+    /// The fingerprint checkpoints store: geometry, materials and textures, emission included.
     #[pyo3(get)]
     pub fingerprint: u64,
     #[pyo3(get)]
@@ -50,18 +50,18 @@ impl PyScene {
         builtin: bool,
     ) -> PyResult<Self> {
         let start = Instant::now();
-        let pool = pools::for_work(py)?;
-        let (world, fingerprint, load_seconds, build_seconds) = watch::abandonable(py, "a load", move || {
+        let pool = pools::for_background(py)?;
+        let (fingerprint, world, load_seconds, build_seconds) = watch::abandonable(py, "a load", move || {
             pool.install(|| {
                 let mut scene = scene()?;
                 for (name, ke) in emission {
                     scene.set_emission(&name, Vec3::from(ke))?;
                 }
                 let load_seconds = start.elapsed().as_secs_f64();
-                let fingerprint = scene_fingerprint(&scene);
                 let build = Instant::now();
                 let world = World::new(scene, BuildPreset::Default);
-                Ok((world, fingerprint, load_seconds, build.elapsed().as_secs_f64()))
+                let build_seconds = build.elapsed().as_secs_f64();
+                Ok((scene_fingerprint(&world), world, load_seconds, build_seconds))
             })
         })?
         .or_py()?;

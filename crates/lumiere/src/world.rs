@@ -150,6 +150,13 @@ impl World {
         self.diameter
     }
 
+    /// The stable hashes of the files material `material`'s diffuse and coverage textures were
+    /// decoded from, `None` where it has none or its file could not be used.
+    pub fn texture_contents(&self, material: usize) -> [Option<u64>; 2] {
+        [(&self.texture_of_material, &self.textures), (&self.cutout_of_material, &self.cutouts)]
+            .map(|(of_material, set)| of_material[material].map(|(id, _)| set.contents_hash(id)))
+    }
+
     /// Problems met while deriving the world (a texture that could not be decoded).
     pub fn warnings(&self) -> &[String] {
         &self.warnings

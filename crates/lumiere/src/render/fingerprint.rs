@@ -3,14 +3,17 @@
 
 use std::hash::Hasher;
 
-use crate::render::RenderOptions;
-use crate::scene::Scene;
+use crate::render::checkpoint::{Checkpoint, differing_options};
+use crate::render::film::Film;
+use crate::render::{RenderOptions, RenderStats};
 use crate::scene::camera::Camera;
-use crate::util::hash::StableHasher;
+use crate::util::hash::{StableHasher, hash_bytes};
+use crate::world::World;
 
-/// The geometry and materials a render sees (emission overrides included).
-pub fn scene_fingerprint(scene: &Scene) -> u64 {
+/// The geometry, materials and textures a render sees (emission overrides included).
+pub fn scene_fingerprint(world: &World) -> u64 {
     let mut h = StableHasher::default();
+    let scene = world.scene();
     let mesh = &scene.mesh;
     h.write_f32s(mesh.positions.iter().flat_map(|p| p.to_array()));
     h.write_f32s(mesh.normals.iter().flat_map(|p| p.to_array()));
@@ -20,7 +23,7 @@ pub fn scene_fingerprint(scene: &Scene) -> u64 {
         indices.iter().flatten().for_each(|&i| h.write_u32(i));
     }
     mesh.material_ids.iter().for_each(|&m| h.write_u32(m));
-    for m in &scene.materials {
+    for (index, m) in scene.materials.iter().enumerate() {
         h.write(m.name.as_bytes());
         h.write_f32s([m.kd, m.ks, m.ke, m.tf].iter().flat_map(|v| v.to_array()).chain([m.ns, m.ni, m.dissolve]));
         h.write_f32s([m.metallic, m.roughness].map(|v| v.unwrap_or(f32::NAN)));
@@ -37,6 +40,19 @@ pub fn scene_fingerprint(scene: &Scene) -> u64 {
             if !transform.is_identity() {
                 h.write(key);
                 h.write_f32s([transform.scale, transform.offset].iter().flat_map(|v| v.to_array()));
+            }
+        }
+        // And the bytes of the files the textures were decoded from: a file edited (or made
+        // usable) between two sessions of a render changes its image. Only where a texture is
+        // named, so that the fingerprints of scenes without one stay what they were.
+        let [map_kd, map_d] = world.texture_contents(index);
+        for (key, named, contents) in
+            [(&b"map_kd file"[..], m.map_kd.is_some(), map_kd), (&b"map_d file"[..], m.map_d.is_some(), map_d)]
+        {
+            if named {
+                h.write(key);
+                h.write_u8(u8::from(contents.is_some()));
+                h.write_u64(contents.unwrap_or(0));
             }
         }
     }
@@ -58,7 +74,64 @@ pub fn options_description(options: &RenderOptions, camera: &Camera) -> String {
     )
 }
 
-/// The fingerprint of [`options_description`].
-pub fn options_fingerprint(options: &RenderOptions, camera: &Camera) -> u64 {
-    crate::util::hash::hash_bytes(options_description(options, camera).as_bytes())
+/// What a checkpoint must match to be resumed by a render: its scene, the options that decide
+/// sample values (seed included, kept as readable text so that a refusal can name what differs),
+/// and the image size.
+#[derive(Clone, Debug)]
+pub struct Fingerprints {
+    scene: u64,
+    options: String,
+    seed: u64,
+    image: (u32, u32),
+}
+
+/// Why a checkpoint cannot be resumed: each front end words it, with its own names for options.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Mismatch {
+    /// Another scene: its geometry, materials, textures or emission differ.
+    Scene,
+    /// Other options: the lines of [`differing_options`] that differ.
+    Options(Vec<String>),
+    /// A film of another size than the image (one saved from Python's film API can be).
+    FilmSize { film: (u32, u32), image: (u32, u32) },
+}
+
+impl Fingerprints {
+    /// `scene` is the world's [`scene_fingerprint`] (a front end that keeps a world keeps it too).
+    pub fn new(scene: u64, options: &RenderOptions, camera: &Camera) -> Fingerprints {
+        Fingerprints {
+            scene,
+            options: options_description(options, camera),
+            seed: options.seed,
+            image: (camera.width, camera.height),
+        }
+    }
+
+    /// The checkpoint of `film` and `stats`, rendered with these fingerprints.
+    pub fn checkpoint(&self, film: Film, stats: RenderStats) -> Checkpoint {
+        Checkpoint {
+            scene_fingerprint: self.scene,
+            options_fingerprint: hash_bytes(self.options.as_bytes()),
+            seed: self.seed,
+            options: self.options.clone(),
+            film,
+            stats,
+        }
+    }
+
+    /// Why `checkpoint` cannot be resumed with these fingerprints, if it cannot.
+    pub fn mismatch(&self, checkpoint: &Checkpoint) -> Option<Mismatch> {
+        let film = (checkpoint.film.width, checkpoint.film.height);
+        if checkpoint.scene_fingerprint != self.scene {
+            Some(Mismatch::Scene)
+        } else if checkpoint.options_fingerprint != hash_bytes(self.options.as_bytes()) || checkpoint.seed != self.seed
+        {
+            Some(Mismatch::Options(differing_options(&checkpoint.options, &self.options)))
+        } else if film != self.image {
+            // Its options name the image size, but its film is written apart.
+            Some(Mismatch::FilmSize { film, image: self.image })
+        } else {
+            None
+        }
+    }
 }

@@ -20,7 +20,7 @@
 //!   and so is the memory each decoding takes, against what is left (in file order, so that
 //!   which files fit never depends on the threads): a file that does not fit is one warning.
 //!
-//! How `World::new` is meant to use it (it does not yet; the world owns the wiring):
+//! How `World` uses it (simplified; `World::new` decodes, `World::bsdf` looks up):
 //!
 //! ```ignore
 //! let (texture_of_material, textures, warnings) =
@@ -38,6 +38,7 @@ use glam::{Vec2, Vec3};
 use image::{DynamicImage, ImageDecoder, ImageFormat, ImageReader, Limits};
 use rayon::prelude::*;
 
+use crate::util::hash::hash_bytes;
 use crate::util::memory::prefetch;
 
 /// The most texels (width × height) an image may have: 2²⁶, e.g. 8192 × 8192, which takes 1 GiB
@@ -116,15 +117,10 @@ impl Texels {
 }
 
 impl Texture {
-    /// Decodes a PNG, JPEG or BMP file's bytes (the format is recognised from its content),
-    /// refusing images of more than [`MAX_TEXELS`] texels from the header alone. The error is a
-    /// short reason, without the file name.
-    pub fn decode(bytes: &[u8]) -> Result<Texture, String> {
-        Texture::decode_named(bytes, None)
-    }
-
-    /// As [`Texture::decode`], for the bytes of the file `name`: a TGA file, whose format has no
-    /// signature to recognise, is known by its extension.
+    /// Decodes the bytes of the file `name`: a PNG, JPEG or BMP is recognised from its content, a
+    /// TGA (whose format has no signature) by its extension. Images of more than [`MAX_TEXELS`]
+    /// texels are refused from the header alone. The error is a short reason, without the file
+    /// name.
     pub fn decode_named(bytes: &[u8], name: Option<&Path>) -> Result<Texture, String> {
         Header::read(bytes, name)?.decode(bytes)
     }
@@ -411,6 +407,9 @@ impl TextureId {
 pub struct TextureSet {
     textures: Vec<Texture>,
     paths: Vec<PathBuf>,
+    /// The stable hash of each file's bytes, taken as it was decoded: a checkpoint's fingerprint
+    /// of the scene holds it, so that a render does not resume over an edited texture.
+    contents: Vec<u64>,
 }
 
 impl TextureSet {
@@ -452,15 +451,18 @@ impl TextureSet {
         let mut left = available;
         let read: Vec<Result<(Vec<u8>, Header), String>> =
             distinct.iter().map(|path| read_within(path, &mut left)).collect();
-        let decoded: Vec<Result<Texture, String>> =
-            read.into_par_iter().map(|file| file.and_then(|(bytes, header)| header.decode(&bytes))).collect();
+        let decoded: Vec<Result<(Texture, u64), String>> = read
+            .into_par_iter()
+            .map(|file| file.and_then(|(bytes, header)| Ok((header.decode(&bytes)?, hash_bytes(&bytes)))))
+            .collect();
         let mut set = TextureSet::default();
         let mut warnings = Vec::new();
         for (path, result) in distinct.into_iter().zip(decoded) {
             match result {
-                Ok(texture) => {
+                Ok((texture, contents)) => {
                     set.textures.push(texture);
                     set.paths.push(path.to_path_buf());
+                    set.contents.push(contents);
                 }
                 Err(reason) => warnings.push(unusable(path, &reason, instead)),
             }
@@ -534,9 +536,9 @@ impl TextureSet {
         &self.textures[id.index()]
     }
 
-    /// The file texture `id` was decoded from.
-    pub fn path(&self, id: TextureId) -> &Path {
-        &self.paths[id.index()]
+    /// The stable hash ([`hash_bytes`]) of the bytes of the file texture `id` was decoded from.
+    pub fn contents_hash(&self, id: TextureId) -> u64 {
+        self.contents[id.index()]
     }
 
     /// Starts loading the texels of texture `id` that a lookup at `uv` reads (see

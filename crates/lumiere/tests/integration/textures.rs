@@ -7,7 +7,11 @@ use std::path::{Path, PathBuf};
 use crate::common::TempDir;
 use glam::{Vec2, Vec3};
 use image::{ImageFormat, Rgb, RgbImage, Rgba, RgbaImage};
+use lumiere::render::fingerprint::scene_fingerprint;
+use lumiere::scene::Scene;
 use lumiere::textures::{MAX_TEXELS, Texture, TextureSet, srgb_to_linear};
+use lumiere::util::hash::hash_bytes;
+use lumiere::world::World;
 
 /// The sRGB decoding curve, written independently in f64.
 fn linear(code: u8) -> f32 {
@@ -253,7 +257,7 @@ fn unusable_files_cost_one_warning_each_and_no_texture() {
     let (ids, set, warnings) = TextureSet::for_materials(map_kd.iter().map(|p| p.as_deref()));
     assert_eq!(set.len(), 1, "the good file, decoded once");
     let good_id = set.id_of(&good).unwrap();
-    assert_eq!(set.path(good_id), good);
+    assert_eq!(set.contents_hash(good_id), hash_bytes(&std::fs::read(&good).unwrap()));
     assert_eq!(ids, vec![None, Some(good_id), None, Some(good_id), None, None, None, None, None]);
     assert_eq!(warnings.len(), 5, "one per distinct unusable file: {warnings:#?}");
     let names = ["missing.png", "garbage.jpg", "truncated.png", "truncated.jpg", "folder.png"];
@@ -452,5 +456,35 @@ fn corrupt_tga_files_are_refused_without_panicking() {
         if let Ok(texture) = Texture::decode_named(&bytes, Some(name)) {
             assert!(u64::from(texture.width()) * u64::from(texture.height()) <= MAX_TEXELS);
         }
+    }
+}
+
+/// A render resumes only over the textures it started with: the scene's fingerprint, which a
+/// checkpoint stores, holds the bytes of each texture file, so an edited texture (or a missing one)
+/// is another scene. It held only their names, and a resume blended two images without a word.
+#[test]
+fn the_scene_fingerprint_holds_the_texture_files_bytes() {
+    let dir = TempDir::new("fingerprint-textures");
+    dir.write("m.mtl", "newmtl wood\nmap_Kd wood.png\nnewmtl leaf\nmap_d mask.png\n");
+    let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n\
+               usemtl wood\nf 1/1 2/2 3/3\nusemtl leaf\nf 1/1 3/3 2/2\n";
+    let scene = dir.write("s.obj", obj);
+    let save = |name: &str, image: &RgbImage| image.save_with_format(dir.path(name), ImageFormat::Png).unwrap();
+    let fingerprint = || scene_fingerprint(&World::new(Scene::load(&scene).unwrap(), Default::default()));
+    save("wood.png", &test_image());
+    save("mask.png", &test_image());
+    let first = fingerprint();
+    assert_eq!(fingerprint(), first, "the same files, the same fingerprint");
+    let mut edited = test_image();
+    edited.put_pixel(1, 1, Rgb([1, 2, 3]));
+    save("wood.png", &edited);
+    let wood_edited = fingerprint();
+    save("mask.png", &edited);
+    let both_edited = fingerprint();
+    std::fs::remove_file(dir.path("wood.png")).unwrap();
+    let wood_missing = fingerprint();
+    let all = [first, wood_edited, both_edited, wood_missing];
+    for (i, a) in all.iter().enumerate() {
+        assert!(all[i + 1..].iter().all(|b| a != b), "{all:x?}");
     }
 }

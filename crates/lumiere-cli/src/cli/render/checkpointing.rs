@@ -1,87 +1,35 @@
-//! Where a render starts (a fresh film, or a checkpoint of the same scene and options) and how its
-//! state is saved.
+//! Where a render starts: a fresh film, or a checkpoint of the same scene and options.
 
 use lumiere::error::shown_path;
 use std::path::Path;
 
-use lumiere::render::RenderOptions;
 use lumiere::render::RenderStats;
-use lumiere::render::checkpoint::{Checkpoint, differing_options};
+use lumiere::render::checkpoint::Checkpoint;
 use lumiere::render::film::Film;
-use lumiere::render::fingerprint::{options_description, scene_fingerprint};
-use lumiere::scene::Scene;
+use lumiere::render::fingerprint::{Fingerprints, Mismatch};
 use lumiere::scene::camera::Camera;
-use lumiere::util::hash::hash_bytes;
 use lumiere::{Error, Result};
 
-/// What a checkpoint must match to be resumed: the scene, and the options that decide sample
-/// values (seed included), kept as readable text so that a refusal can name what differs.
-#[derive(Clone, Debug)]
-pub struct Fingerprints {
-    scene: u64,
-    options: String,
-    seed: u64,
-}
-
-impl Fingerprints {
-    pub fn new(scene: &Scene, options: &RenderOptions, camera: &Camera) -> Fingerprints {
-        Fingerprints {
-            scene: scene_fingerprint(scene),
-            options: options_description(options, camera),
-            seed: options.seed,
+/// Where a render starts, from `fingerprints` (see [`Fingerprints`]): the film and totals of the
+/// checkpoint `resume`, refused unless it was made from the same scene and options, or fresh ones.
+pub fn start(fingerprints: &Fingerprints, resume: Option<&Path>, camera: &Camera) -> Result<(Film, RenderStats)> {
+    let Some(path) = resume else {
+        return Ok((Film::new(camera.width, camera.height)?, RenderStats::default()));
+    };
+    let checkpoint = Checkpoint::load(path)?;
+    let why = match fingerprints.mismatch(&checkpoint) {
+        None => return Ok((checkpoint.film, checkpoint.stats)),
+        Some(Mismatch::Scene) => {
+            "the checkpoint was rendered from a different scene (geometry, materials, textures or --emission)"
+                .to_string()
         }
-    }
-
-    /// The film and totals to start from: those of the checkpoint `resume`, or fresh ones.
-    pub fn start(&self, resume: Option<&Path>, camera: &Camera) -> Result<(Film, RenderStats)> {
-        match resume {
-            Some(path) => self.resume(path, camera),
-            None => Ok((Film::new(camera.width, camera.height)?, RenderStats::default())),
+        Some(Mismatch::Options(differing)) => format!(
+            "the checkpoint was rendered with other options: {}; only --spp, the budgets, --threads and the outputs may change",
+            differing.join(", ")
+        ),
+        Some(Mismatch::FilmSize { film, image }) => {
+            format!("the checkpoint's film is {}x{}, but the image is {}x{}", film.0, film.1, image.0, image.1)
         }
-    }
-
-    /// Loads a checkpoint and refuses it unless it was made from the same scene and options.
-    fn resume(&self, path: &Path, camera: &Camera) -> Result<(Film, RenderStats)> {
-        let checkpoint = Checkpoint::load(path)?;
-        if checkpoint.scene_fingerprint != self.scene {
-            return Err(Error::invalid(format!(
-                "{}: cannot resume: the checkpoint was rendered from a different scene (geometry, materials or --emission)",
-                shown_path(path)
-            )));
-        }
-        if checkpoint.options_fingerprint != hash_bytes(self.options.as_bytes()) || checkpoint.seed != self.seed {
-            let differing = differing_options(&checkpoint.options, &self.options);
-            return Err(Error::invalid(format!(
-                "{}: cannot resume: the checkpoint was rendered with other options: {}; only --spp, the budgets, --threads and the outputs may change",
-                shown_path(path),
-                differing.join(", ")
-            )));
-        }
-        // Its options name the camera's size, but its film is written apart (a checkpoint saved
-        // from Python's film API can hold a film of another size): refused here, with the file.
-        let film = &checkpoint.film;
-        if (film.width, film.height) != (camera.width, camera.height) {
-            return Err(Error::invalid(format!(
-                "{}: cannot resume: the checkpoint's film is {}x{}, but the image is {}x{}",
-                shown_path(path),
-                film.width,
-                film.height,
-                camera.width,
-                camera.height
-            )));
-        }
-        Ok((checkpoint.film, checkpoint.stats))
-    }
-
-    pub fn save(&self, path: &Path, film: &Film, stats: &RenderStats) -> Result<()> {
-        let checkpoint = Checkpoint {
-            scene_fingerprint: self.scene,
-            options_fingerprint: hash_bytes(self.options.as_bytes()),
-            seed: self.seed,
-            options: self.options.clone(),
-            film: film.clone(),
-            stats: *stats,
-        };
-        checkpoint.save(path)
-    }
+    };
+    Err(Error::invalid(format!("{}: cannot resume: {why}", shown_path(path))))
 }

@@ -19,6 +19,7 @@ use lumiere::error::{Error, shown_name, shown_path};
 use lumiere::image_io::{ExrLayer, PngEncoding, PngStyle, Tonemap, write_exr_with_layers, write_image};
 use lumiere::render::aov::{Aov, render_aovs};
 use lumiere::render::film::Film;
+use lumiere::render::fingerprint::{Fingerprints, scene_fingerprint};
 use lumiere::render::{Hooks, RenderOptions, RenderOutput, RenderStats, StopReason, render_progressive};
 use lumiere::scene::Scene;
 use lumiere::scene::camera::Camera;
@@ -27,7 +28,6 @@ use lumiere::world::World;
 
 use super::args::{ModeArg, RenderArgs, TonemapArg};
 use super::output;
-use checkpointing::Fingerprints;
 use report::Timings;
 
 /// Exit code of a render stopped by SIGINT or SIGTERM (its image of completed samples is written).
@@ -56,9 +56,18 @@ fn render(args: &RenderArgs, threads: usize, denoiser: Option<&oidn::Oidn>) -> R
     paths::check_against_sources(args, &scene)?;
     let camera = camera::from_args(args, &scene)?;
     let options = options::from_args(args);
-    let fingerprints = Fingerprints::new(&scene, &options, &camera);
     check_memory_for_outputs(args, &camera)?;
-    let (film, stats) = fingerprints.start(args.resume.as_deref(), &camera)?;
+
+    let build_start = Instant::now();
+    let world = World::with_isa(scene, BuildPreset::Default, isa);
+    for warning in world.warnings() {
+        output::warn(warning);
+    }
+    let timings = Timings { load_ms, build_ms: build_start.elapsed().as_secs_f64() * 1e3 };
+
+    // After the build: the scene's fingerprint holds its decoded textures' bytes.
+    let fingerprints = Fingerprints::new(scene_fingerprint(&world), &options, &camera);
+    let (film, stats) = checkpointing::start(&fingerprints, args.resume.as_deref(), &camera)?;
     if let Some(resume) = args.resume.as_deref().filter(|_| film.samples > options.spp) {
         // Samples cannot be taken back out of a film: say that the image will have them all.
         output::warn(format_args!(
@@ -70,13 +79,6 @@ fn render(args: &RenderArgs, threads: usize, denoiser: Option<&oidn::Oidn>) -> R
         ));
     }
 
-    let build_start = Instant::now();
-    let world = World::with_isa(scene, BuildPreset::Default, isa);
-    for warning in world.warnings() {
-        output::warn(warning);
-    }
-    let timings = Timings { load_ms, build_ms: build_start.elapsed().as_secs_f64() * 1e3 };
-
     report::warn_if_unlit(&world, &options);
     signals::rendering_starts();
     let output = render_passes(args, &world, &camera, &options, &fingerprints, film, stats)?;
@@ -86,7 +88,8 @@ fn render(args: &RenderArgs, threads: usize, denoiser: Option<&oidn::Oidn>) -> R
     report::warn_if_black(&output, &options.technique);
     write_output(args, &world, &camera, &options, &output, denoiser)?;
     // Its error (a full disk) comes after the image, the summary and the statistics are out.
-    let checkpoint = args.checkpoint.as_ref().map(|path| fingerprints.save(path, &output.film, &output.stats));
+    let checkpoint =
+        args.checkpoint.as_ref().map(|path| fingerprints.checkpoint(output.film.clone(), output.stats).save(path));
     report::summary(&options, &camera, &output, threads, &args.output);
     if let Some(path) = &args.stats_json {
         let json = report::stats_json(&world, &options, &camera, &output, threads, &timings)?;
@@ -186,7 +189,7 @@ fn render_passes(
             // A checkpoint that cannot be written (a full disk) must not cost the render: the
             // passes go on to the image, the checkpoint written last stays as it was, and the
             // final checkpoint's error, after the image, makes the exit code.
-            if let Err(e) = fingerprints.save(path, film, stats)
+            if let Err(e) = fingerprints.checkpoint(film.clone(), *stats).save(path)
                 && !std::mem::replace(&mut checkpoint_failed, true)
             {
                 output::warn(format_args!(
