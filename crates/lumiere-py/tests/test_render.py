@@ -77,6 +77,18 @@ def test_same_seed_same_bits_for_any_thread_count():
     assert not np.array_equal(bits(one), bits(other))
 
 
+def test_threads_0_follows_rayon_num_threads_as_it_is_now(monkeypatch):
+    # The pool kept for threads=0 was reused by its argument, not by the count it stood for: once
+    # started, RAYON_NUM_THREADS no longer changed it, until another count came between.
+    def threads():
+        return lumiere.render_full(lumiere.builtin(), mode="hits", size=(8, 6)).stats["threads"]
+
+    monkeypatch.setenv("RAYON_NUM_THREADS", "2")
+    assert threads() == 2
+    monkeypatch.setenv("RAYON_NUM_THREADS", "1")
+    assert threads() == 1
+
+
 def test_aovs_come_back_as_a_dict_of_arrays():
     out = lumiere.render(lumiere.builtin(), spp=2, size=(32, 24), aovs=("albedo", "normal", "depth"))
     assert set(out) == {"color", "albedo", "normal", "depth"}
