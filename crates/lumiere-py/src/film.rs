@@ -16,6 +16,7 @@ use pyo3::types::PyByteArray;
 
 use crate::camera::PyCamera;
 use crate::errors::{OrPyErr, invalid, unsigned};
+use crate::files;
 use crate::options::PyOptions;
 use crate::pixels::{from_bytes, to_bytearray};
 use crate::pools;
@@ -49,10 +50,7 @@ pub fn render_passes<'py>(
     // Leaves no warnings: any stack level does.
     let passes = watch::run(py, Some(total), progress.as_ref(), 1, move |watch| {
         let (world, camera, options) = (&*world, &camera, &options);
-        let count_samples = |n| {
-            watch.done.fetch_add(n, std::sync::atomic::Ordering::Relaxed);
-        };
-        pool.install(|| render_pass_range(world, camera, options, first, count, &count_samples, &watch.cancel))
+        pool.install(|| render_pass_range(world, camera, options, first, count, &|n| watch.count(n), &watch.cancel))
     })?;
     passes.iter().map(|p| Ok((p.sample, to_bytearray(py, &p.values)?, p.rays))).collect()
 }
@@ -143,7 +141,11 @@ impl PyFilm {
         let fingerprints = Fingerprints::new(scene.fingerprint, &options.options, &camera.camera);
         let checkpoint = fingerprints.checkpoint(self.film.clone(), self.stats);
         let pool = pools::for_background(py)?;
-        py.detach(|| pool.install(|| checkpoint.save(&path))).or_py()
+        py.detach(|| {
+            files::tidy_beside(&path);
+            pool.install(|| checkpoint.save(&path))
+        })
+        .or_py()
     }
 
     /// The film of a checkpoint, refused (naming what differs) unless it was rendered from the

@@ -9,6 +9,7 @@ use lumiere::util::write::{check_writable, write_atomically};
 use pyo3::prelude::*;
 
 use crate::errors::{OrPyErr, invalid};
+use crate::files;
 use crate::pixels::from_bytes;
 use crate::{pools, watch};
 
@@ -34,7 +35,11 @@ pub fn write_image(
         pool.install(|| encode_image(&target, width, height, &pixels, style))
     })?
     .or_py()?;
-    py.detach(|| write_atomically(&path, &bytes)).or_py()
+    py.detach(|| {
+        files::tidy_beside(&path);
+        write_atomically(&path, &bytes)
+    })
+    .or_py()
 }
 
 /// Refuses, before a long render, an image output that [`write_image`] would refuse after it: a

@@ -52,9 +52,7 @@ pub fn render<'py>(
             if let Some(reason) = unlit(world, &options.technique) {
                 warn(unlit_message(&reason, options.technique.name()));
             }
-            let count = |n| {
-                watch.done.fetch_add(n, std::sync::atomic::Ordering::Relaxed);
-            };
+            let count = |n| watch.count(n);
             let spp = (options.spp != u32::MAX).then_some(options.spp);
             let mut forecast = NoiseForecast::new(options.noise_target, spp, options.time_budget, film.samples);
             let mut pass_done = |film: &Film, _: &RenderStats| {

@@ -29,6 +29,14 @@ pub struct Watch {
     pub warnings: Mutex<Vec<String>>,
 }
 
+impl Watch {
+    /// Counts `samples` more pixel samples done, for the progress callback: a render's progress
+    /// hook.
+    pub fn count(&self, samples: u64) {
+        self.done.fetch_add(samples, Ordering::Relaxed);
+    }
+}
+
 /// Runs `work` on a new thread; calls `progress(done, total)` as `watch.done` moves (and once at
 /// the end), and issues the warnings it leaves `stacklevel` frames up from the caller (1: the
 /// caller's line). The result of `work`, or the first signal or callback exception. The thread

@@ -96,3 +96,14 @@ def test_the_command_line_never_writes_over_an_input_or_another_output(scene_fil
     assert last.startswith("lumiere.distributed: error: ") and "no Ray cluster" not in last, result.stderr
     assert re.search(message, last), last
     assert {name: (scene_files / name).read_bytes() for name in os.listdir(scene_files)} == before
+
+
+def test_writing_an_image_clears_away_temporaries_that_killed_writers_left(tmp_path):
+    # As the CLI does before it writes: a temporary that no process holds and that has gone
+    # unwritten for 10 s was left by a killed writer. Python's writes left them for ever.
+    stale, live = tmp_path / ".lumiere-1-0.tmp", tmp_path / ".lumiere-1-1.tmp"
+    stale.write_bytes(b"half an image")
+    live.write_bytes(b"written just now")
+    os.utime(stale, (0, 0))
+    lumiere.write_image(tmp_path / "x.pfm", lumiere.render(lumiere.builtin(), mode="hits", size=(4, 3)))
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".lumiere-1-1.tmp", "x.pfm"]

@@ -48,6 +48,14 @@ impl RenderOptions {
         if camera.width == 0 || camera.height == 0 {
             return Err(Error::invalid(format!("image size {}x{} has no pixels", camera.width, camera.height)));
         }
+        // Pixels are numbered in 32 bits for the sampler: past that, two pixels would share
+        // their random numbers (no machine today holds such a film, but the check is free).
+        if u64::from(camera.width) * u64::from(camera.height) > u64::from(u32::MAX) {
+            return Err(Error::invalid(format!(
+                "image size {}x{} has more than 4,294,967,295 pixels, the most a render numbers",
+                camera.width, camera.height
+            )));
+        }
         self.technique.validate()?;
         if self.spp == 0 {
             return Err(Error::invalid("the samples per pixel (spp) must be at least 1"));

@@ -81,3 +81,14 @@ fn a_range_of_billions_of_passes_reserves_nothing_up_front() {
     let passes = render_pass_range(&world, &camera, &options, 0, u32::MAX - 1, &|_| {}, &cancel).unwrap();
     assert!(passes.is_empty());
 }
+
+/// Pixels are numbered in 32 bits for the sampler: an image of more pixels is refused rather than
+/// rendered with pixels that share their random numbers.
+#[test]
+fn an_image_of_more_pixels_than_32_bits_number_is_refused() {
+    let (world, camera) = cornell(65_536, 65_536);
+    let options = RenderOptions::new(Technique::Path(Path::default()));
+    let cancel = AtomicBool::new(true);
+    let error = render_pass_range(&world, &camera, &options, 0, 1, &|_| {}, &cancel).unwrap_err().to_string();
+    assert!(error.contains("more than 4,294,967,295 pixels"), "{error}");
+}

@@ -6,8 +6,8 @@
 //! once and reports errors with their line number in the file, with no fix-up pass afterwards.
 
 use super::skipped::{SkippedKeywords, is_silent};
-use super::text::{Tokens, finite_f32, lines, quoted, saturating_i64};
-use crate::error::{Error, Result};
+use super::text::{Tokens, finite_f32, lines, saturating_i64};
+use crate::error::{Error, Result, quote};
 use crate::scene::mesh::NO_INDEX;
 use glam::{Vec2, Vec3};
 use std::borrow::Cow;
@@ -276,7 +276,7 @@ impl<'a> ChunkParser<'a> {
     /// A position out of range is an error; a texture coordinate or a normal out of range (or 0)
     /// is dropped (the corner has none), as mainstream loaders accept such files.
     fn corner(&self, token: &[u8]) -> Result<(Corner, CornerDropped), String> {
-        let malformed = || format!("malformed face corner {} (expected v, v/vt, v//vn or v/vt/vn)", quoted(token));
+        let malformed = || format!("malformed face corner {} (expected v, v/vt, v//vn or v/vt/vn)", quote(token));
         let CornerFields { position, texcoord, normal } = corner_fields(token).ok_or_else(malformed)?;
         let raw = |field: &[u8]| saturating_i64(field).ok_or_else(malformed);
         let position = self.resolve(raw(position)?, position, Attribute::Position)?;
@@ -306,7 +306,7 @@ impl<'a> ChunkParser<'a> {
             Attribute::Normal => ("normal", self.start.normals + self.mesh.normals.len(), self.totals.normals),
         };
         // Digits only (the field parsed as an integer), but maybe 10 MB of them: cut like names.
-        let field = || if field.len() <= 40 { String::from_utf8_lossy(field).into_owned() } else { quoted(field) };
+        let field = || if field.len() <= 40 { String::from_utf8_lossy(field).into_owned() } else { quote(field) };
         if raw == 0 {
             return Err(format!("{what} index 0: OBJ indices start at 1"));
         }

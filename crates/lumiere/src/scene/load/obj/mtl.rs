@@ -2,9 +2,7 @@
 //! because a render with one wrong material is more useful than no render.
 
 use super::continued::{has_continuations, joined};
-use super::text::{
-    LONE_CARRIAGE_RETURNS, Tokens, finite_f32, has_lone_carriage_returns, lines, path_from_bytes, quoted,
-};
+use super::text::{LONE_CARRIAGE_RETURNS, Tokens, finite_f32, has_lone_carriage_returns, lines, path_from_bytes};
 use crate::error::{quote, shown_path};
 use crate::materials::{Material, MaterialKind};
 use crate::math::UvTransform;
@@ -248,7 +246,7 @@ fn integer<'a>(mut tokens: impl Iterator<Item = &'a [u8]>) -> Result<u32, String
         (Some(token), None) => std::str::from_utf8(token)
             .ok()
             .and_then(|text| text.parse().ok())
-            .ok_or_else(|| format!("malformed integer {}", quoted(token))),
+            .ok_or_else(|| format!("malformed integer {}", quote(token))),
         _ => Err("expected exactly one integer".to_string()),
     }
 }
@@ -364,7 +362,7 @@ fn take_values<'a>(
             _ => None,
         };
         let problem = problem.unwrap_or_else(|| format!("expected {least} value(s), found {}", values.len()));
-        return Err(format!("{keyword} {}: {problem}", quoted(option)));
+        return Err(format!("{keyword} {}: {problem}", quote(option)));
     }
     Ok(values)
 }

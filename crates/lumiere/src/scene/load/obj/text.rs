@@ -87,19 +87,13 @@ impl<'a> Iterator for Tokens<'a> {
     }
 }
 
-/// The token as it should appear in a message: quoted, escaped and cut (see [`quote`]), so that a
-/// hostile 10 MB token does not make a 10 MB message.
-pub(super) fn quoted(token: &[u8]) -> String {
-    quote(token)
-}
-
 /// Parses a finite `f32`. NaN and infinities are refused: they would poison the BVH bounds.
 pub(super) fn finite_f32(token: &[u8]) -> Result<f32, String> {
     let value = std::str::from_utf8(token).ok().and_then(|text| text.parse::<f32>().ok());
     match value {
         Some(x) if x.is_finite() => Ok(x),
-        Some(_) => Err(format!("number {} is not finite", quoted(token))),
-        None => Err(format!("malformed number {}", quoted(token))),
+        Some(_) => Err(format!("number {} is not finite", quote(token))),
+        None => Err(format!("malformed number {}", quote(token))),
     }
 }
 
