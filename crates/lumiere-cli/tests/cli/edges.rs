@@ -653,5 +653,8 @@ fn info_names_missing_textures() {
         stderr(&out).lines().filter(|l| l.contains("warning: texture")).map(String::from).collect();
     assert_eq!(warnings.len(), 2, "{warnings:?}");
     assert!(warnings[0].contains("missing wood.png") && warnings[0].contains("Kd is used instead"), "{warnings:?}");
-    assert!(warnings[1].contains("folder.png\": not a regular file; the material stays opaque"), "{warnings:?}");
+    assert!(
+        warnings[1].contains("folder.png\": is a directory, not a regular file; the material stays opaque"),
+        "{warnings:?}"
+    );
 }

@@ -583,9 +583,7 @@ fn unusable(path: &Path, reason: &str, instead: &str) -> String {
 /// larger than [`MAX_FILE_BYTES`].
 fn check_file(path: &Path) -> Result<(), String> {
     let metadata = std::fs::metadata(path).map_err(|e| e.to_string())?;
-    if !metadata.is_file() {
-        return Err("not a regular file".to_string());
-    }
+    crate::util::read::refuse_special(&metadata).map_err(|e| e.to_string())?;
     if metadata.len() > MAX_FILE_BYTES {
         return Err(format!("the file has {} bytes, over the limit of {MAX_FILE_BYTES}", metadata.len()));
     }

@@ -174,9 +174,9 @@ fn check_target(path: &Path) -> Result<()> {
     if metadata.is_dir() {
         return Err(Error::invalid(format!("{}: is a directory, expected a file name", shown_path(path))));
     }
-    if !metadata.is_file() {
+    if let Err(kind) = crate::util::read::refuse_special(&metadata) {
         return Err(Error::invalid(format!(
-            "{}: exists and is not a regular file (a device, FIFO or socket); lumiere writes only regular files",
+            "{}: exists and {kind}; lumiere writes only regular files",
             shown_path(path)
         )));
     }
