@@ -1,5 +1,7 @@
 //! Stable 64-bit fingerprints of a scene and of render options, stored in checkpoints so that a
-//! render is never resumed with different inputs. Not cryptographic: it guards against mistakes.
+//! render is never resumed with different inputs, and the reasons a checkpoint cannot be resumed
+//! ([`Fingerprints::mismatch`]), which the CLI and the Python module word. Not cryptographic: it
+//! guards against mistakes.
 
 use std::hash::Hasher;
 

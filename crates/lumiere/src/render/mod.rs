@@ -173,48 +173,43 @@ fn run_passes<I: Integrator>(
                 }
             });
         }
-        let noise_reached = |film: &Film| {
-            options.noise_target.is_some_and(|target| film.relative_error().is_some_and(|error| error <= target))
-        };
-        // A resumed film may already meet the target: a run killed after its last pass's
-        // checkpoint was saved but before it stopped. Asking first keeps the bytes of the run
-        // that was not killed. Later passes are asked about as they end.
-        let outcome = if noise_reached(&film) {
-            (StopReason::NoiseTarget, Ok(()))
-        } else {
-            loop {
-                if film.samples >= options.spp {
-                    break (StopReason::Completed, Ok(()));
+        let outcome = loop {
+            // Asked before each pass, the first too: a resumed film may already meet the target
+            // (a run killed after its last pass's checkpoint was saved, but before it stopped),
+            // and must stop where the run that was not killed stopped. Only with a target: the
+            // estimate is a serial sweep over the film.
+            if let Some(target) = options.noise_target
+                && film.relative_error().is_some_and(|error| error <= target)
+            {
+                break (StopReason::NoiseTarget, Ok(()));
+            }
+            if film.samples >= options.spp {
+                break (StopReason::Completed, Ok(()));
+            }
+            if let Some(reason) = stop_now() {
+                break (reason, Ok(()));
+            }
+            let pass = Pass { sampler: &sampler, sample: film.samples, pixel_centre };
+            if buffer.is_empty() {
+                match pass_buffer(camera.width, camera.height) {
+                    Ok(fresh) => buffer = fresh,
+                    Err(e) => break (StopReason::Interrupted, Err(e)),
                 }
-                if let Some(reason) = stop_now() {
-                    break (reason, Ok(()));
-                }
-                let pass = Pass { sampler: &sampler, sample: film.samples, pixel_centre };
-                if buffer.is_empty() {
-                    match pass_buffer(camera.width, camera.height) {
-                        Ok(fresh) => buffer = fresh,
-                        Err(e) => break (StopReason::Interrupted, Err(e)),
-                    }
-                }
-                let Some(rays) = render_pass(integrator, world, camera, &pass, &mut buffer, hooks.progress, &stop_now)
-                else {
-                    // The pass in flight is abandoned: the film keeps whole passes only.
-                    break (stop_now().unwrap_or(StopReason::Interrupted), Ok(()));
-                };
-                if let Err(e) = film.add_rendered(&mut buffer) {
-                    break (StopReason::Interrupted, Err(e));
-                }
-                // Saturating: a checkpoint's count may already be near the top (the checksum does not
-                // stop a forged one), and a total is no reason to wrap or panic.
-                stats.rays = stats.rays.saturating_add(rays);
-                stats.elapsed = before + start.elapsed();
-                if let Err(e) = (hooks.pass_done)(&film, &stats) {
-                    break (StopReason::Interrupted, Err(e));
-                }
-                // Only with a target: the estimate is a serial sweep over the film.
-                if noise_reached(&film) {
-                    break (StopReason::NoiseTarget, Ok(()));
-                }
+            }
+            let Some(rays) = render_pass(integrator, world, camera, &pass, &mut buffer, hooks.progress, &stop_now)
+            else {
+                // The pass in flight is abandoned: the film keeps whole passes only.
+                break (stop_now().unwrap_or(StopReason::Interrupted), Ok(()));
+            };
+            if let Err(e) = film.add_rendered(&mut buffer) {
+                break (StopReason::Interrupted, Err(e));
+            }
+            // Saturating: a checkpoint's count may already be near the top (the checksum does not
+            // stop a forged one), and a total is no reason to wrap or panic.
+            stats.rays = stats.rays.saturating_add(rays);
+            stats.elapsed = before + start.elapsed();
+            if let Err(e) = (hooks.pass_done)(&film, &stats) {
+                break (StopReason::Interrupted, Err(e));
             }
         };
         drop(render_done);
