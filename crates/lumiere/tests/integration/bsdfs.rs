@@ -249,6 +249,56 @@ fn visible_normal_sampling_round_trips() {
     }
 }
 
+/// Smith's terms against their closed forms, evaluated in f64 from the angles alone:
+/// `Λ = (√(1 + α² tan²θ) − 1) / 2`, `G1 = 1 / (1 + Λ)`, `G2 = 1 / (1 + Λo + Λi)` (symmetric to the
+/// last bit, between the separable `G1 G1` and the smaller `G1`), and `reflection()`'s value and
+/// pdf against `D(h) G2 / (4 cos θo cos θi)` and `G1(ωo) D(h) / (4 cos θo)`. The sampling tests
+/// cannot see a wrong value: a lobe samples its own pdf whatever `f` it returns, the white furnace
+/// only bounds the albedo, and `g2` lies on no sampling path at all.
+#[test]
+fn smith_terms_and_reflection_values_match_their_closed_forms() {
+    let mut rng = TestRng(111);
+    for alpha in [0.05f64, 0.3, 0.8] {
+        let ggx = Ggx::new(alpha as f32);
+        let a2 = alpha * alpha;
+        let lambda = |w: DVec3| ((1.0 + a2 * (w.x * w.x + w.y * w.y) / (w.z * w.z)).sqrt() - 1.0) / 2.0;
+        let d = |m: DVec3| {
+            let k = m.z * m.z + (m.x * m.x + m.y * m.y) / a2;
+            1.0 / (PI * a2 * k * k)
+        };
+        let close = |got: f32, expected: f64, what: &str| {
+            assert!(
+                (got as f64 - expected).abs() <= 2e-4 * expected.abs(),
+                "α {alpha}: {what} = {got}, expected {expected}"
+            );
+        };
+        for _ in 0..5000 {
+            // Above the surface, at least 3° off the horizon (where f32 and f64 part ways).
+            let mut upper = || {
+                let w = rng.direction();
+                Vec3::new(w.x, w.y, w.z.abs().max(0.05)).normalize()
+            };
+            let (wo, wi) = (upper(), upper());
+            let (o, i) = (wo.as_dvec3(), wi.as_dvec3());
+            let (lambda_o, lambda_i) = (lambda(o), lambda(i));
+            close(ggx.lambda(wo), lambda_o, "Λ(ωo)");
+            close(ggx.g1(wo), 1.0 / (1.0 + lambda_o), "G1(ωo)");
+            let g2_exact = 1.0 / (1.0 + lambda_o + lambda_i);
+            close(ggx.g2(wo, wi), g2_exact, "G2");
+            assert_eq!(ggx.g2(wo, wi), ggx.g2(wi, wo), "G2 is symmetric");
+            let (g1_o, g1_i, g2) = (ggx.g1(wo), ggx.g1(wi), ggx.g2(wo, wi));
+            assert!(
+                g2 >= g1_o * g1_i * (1.0 - 1e-6) && g2 <= g1_o.min(g1_i) * (1.0 + 1e-6),
+                "G2 {g2}, G1 {g1_o} {g1_i}"
+            );
+            let h = (o + i).normalize();
+            let r = ggx.reflection(wo, wi).expect("both above the surface");
+            close(r.value, d(h) * g2_exact / (4.0 * o.z * i.z), "D G2 / (4 cos θo cos θi)");
+            close(r.pdf, d(h) / ((1.0 + lambda_o) * 4.0 * o.z), "G1(ωo) D / (4 cos θo)");
+        }
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Sampling agrees with pdf
 
@@ -282,6 +332,37 @@ fn plastic_mixtures_follow_their_pdf() {
         let wo = viewing_directions()[1].1;
         assert_passes(&format!("plastic, {name}"), lobe_chi2(&bsdf, wo, 2000 + i as u64, 64));
     }
+}
+
+/// The plastic picks its specular lobe with the probability its documentation gives, the mean of
+/// `ks` over the sum of the means of `ks` and of the scaled `kd`, and its diffuse lobe otherwise.
+/// The mixture tests cannot see the choice: a plastic that picked its lobes in other proportions
+/// would still sample the mixture density it claims, and only its variance would suffer. At normal
+/// incidence a fraction `α² / (1 + α²)` of the specular samples falls below the horizon and is
+/// rejected (see `pdfs_integrate_to_at_most_one`), so samples come in three kinds, counted by flags.
+#[test]
+fn plastic_picks_its_lobes_in_proportion_to_their_albedo_estimates() {
+    let (kd, ks, alpha) = (Vec3::new(0.7, 0.5, 0.3), Vec3::new(0.3, 0.1, 0.05), 0.3f64);
+    let plastic = Plastic::new(kd, ks, alpha as f32);
+    let mean = |v: Vec3| (v.x as f64 + v.y as f64 + v.z as f64) / 3.0;
+    let specular = mean(ks) / (mean(ks) + mean(kd * (1.0 - ks.max_element())));
+    assert!((plastic.specular_probability() as f64 - specular).abs() < 1e-6, "{}", plastic.specular_probability());
+    let kept = 1.0 / (1.0 + alpha * alpha);
+    let expected = [specular * kept, 1.0 - specular, specular * (1.0 - kept)];
+    let mut rng = TestRng(121);
+    let mut counts = [0u64; 3];
+    for _ in 0..200_000 {
+        let kind = match plastic.sample(Vec3::Z, Vec2::new(rng.f32(), rng.f32())) {
+            Some(s) if s.flags.contains(BsdfFlags::GLOSSY) => 0,
+            Some(s) => {
+                assert!(s.flags.contains(BsdfFlags::DIFFUSE), "{s:?}");
+                1
+            }
+            None => 2,
+        };
+        counts[kind] += 1;
+    }
+    assert_passes("plastic lobe choice", lumiere::sampling::chi2::chi2_discrete(&expected, &counts));
 }
 
 /// Every sample carries exactly `eval` and `pdf` of its direction, with flags that say what it is;
@@ -751,4 +832,22 @@ fn microfacet_reflection_terms_are_consistent() {
             assert!((r.pdf - pdf).abs() <= 1e-4 * pdf.max(1e-3), "{} vs {pdf}", r.pdf);
         }
     }
+}
+
+/// `albedo` (what a denoiser's albedo buffer gets) is the colour each lobe documents: Lambert's
+/// reflectance, a metal's or a mirror's `F0`, the plastic's scaled base plus its coat, and glass's
+/// `R0 + (1 − R0) tf`. Nothing else looks at these values, so only a test of them can catch one.
+#[test]
+fn albedos_are_the_documented_colours() {
+    let colour = Vec3::new(0.9, 0.6, 0.3);
+    assert_eq!(Lambert { reflectance: colour }.albedo(), colour);
+    assert_eq!(Conductor::new(colour, 0.3).albedo(), colour);
+    assert_eq!(Mirror::new(colour).albedo(), colour);
+    let plastic = Plastic::new(colour, Vec3::new(0.2, 0.1, 0.05), 0.3);
+    assert!((plastic.diffuse() - colour * 0.8).abs().max_element() < 1e-6, "{}", plastic.diffuse());
+    assert_eq!(plastic.albedo(), plastic.diffuse() + plastic.specular());
+    // η 1.5: R0 = (0.5 / 2.5)² = 0.04.
+    let glass = Dielectric::new(1.5, colour);
+    let expected = Vec3::splat(0.04) + colour * 0.96;
+    assert!((glass.albedo() - expected).abs().max_element() < 1e-6, "{} vs {expected}", glass.albedo());
 }

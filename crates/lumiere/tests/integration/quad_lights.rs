@@ -117,3 +117,55 @@ fn shafts_to_quads_keep_every_blocker() {
     assert!(blocked * 20 > rays && blocked * 10 < rays * 9, "{blocked} of {rays} segments blocked: no test");
     assert!(differ * 10_000 <= rays, "{differ} of {rays} segments differ");
 }
+
+/// "Strictly convex" is strict: a triangle split in two along a median makes four corners of
+/// which one is straight (180°, a turn of exactly 0), and pairs into no quad, whichever way it
+/// faces and whichever half comes first.
+#[test]
+fn a_triangle_split_along_a_median_is_no_quad() {
+    let v = |x: f32, z: f32| Vec3::new(x, 2.0, z);
+    // (0, 0), (2, 0), (0, 2) split at (1, 1), the middle of its long side; facing down.
+    let halves = [[v(0.0, 0.0), v(2.0, 0.0), v(1.0, 1.0)], [v(0.0, 0.0), v(1.0, 1.0), v(0.0, 2.0)]];
+    let flip = |[a, b, c]: [Vec3; 3]| [a, c, b];
+    for facing in [halves, halves.map(flip)] {
+        for order in [[0, 1], [1, 0]] {
+            let triangles = order.map(|k| (facing[k], true));
+            assert_eq!(quads(&triangles), [None, None], "{triangles:?}");
+        }
+    }
+    // The same halves with the far corner moved out by a little are a convex quad.
+    let kite = [([v(0.0, 0.0), v(2.0, 0.0), v(1.1, 1.1)], true), ([v(0.0, 0.0), v(1.1, 1.1), v(0.0, 2.0)], true)];
+    assert_eq!(quads(&kite), [Some(0), Some(0)]);
+}
+
+/// The quad's plane keeps every shadow target of both its triangles on it or in front of it, as
+/// its documentation says (nothing behind the plane may block a segment): for quads rotated
+/// anywhere, where the targets of the second triangle often lie a few ulps behind the plane
+/// through the first's, and the plane must move back for them.
+#[test]
+fn quad_planes_keep_every_shadow_target_in_front() {
+    let mut rng = TestRng(4343);
+    let mut moved = 0;
+    for _ in 0..300 {
+        let rotation = Quat::from_axis_angle(rng.direction(), rng.range(0.0, std::f32::consts::TAU));
+        let (w, d, skew) = (rng.range(0.3, 3.0), rng.range(0.3, 3.0), rng.range(-1.0, 1.0));
+        let offset = rng.vec3(-5.0, 5.0);
+        let corners =
+            [Vec3::new(0.0, 4.0, 0.0), Vec3::new(w, 4.0, 0.0), Vec3::new(w + skew, 4.0, d), Vec3::new(skew, 4.0, d)]
+                .map(|p| rotation * p + offset);
+        let world =
+            world_of(&[([corners[0], corners[1], corners[2]], true), ([corners[0], corners[2], corners[3]], true)]);
+        let lights = world.lights();
+        let Some((_, quad)) = lights.quad_of(0) else { panic!("{corners:?}: no quad") };
+        let n = quad.plane.truncate();
+        for light in &lights.lights()[..2] {
+            for t in light.shadow_targets {
+                let distance = n.dot(t) + quad.plane.w;
+                assert!(distance >= 0.0, "{corners:?}: target {t} lies {distance} behind the plane");
+            }
+        }
+        moved += usize::from(quad.plane.w != -n.dot(lights.lights()[0].shadow_targets[0]));
+    }
+    // The test has teeth only if the plane had to move for some quads.
+    assert!(moved > 30, "the plane moved for {moved} quads only");
+}

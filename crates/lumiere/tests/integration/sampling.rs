@@ -384,6 +384,33 @@ fn alias_table_rejects_nothing_to_sample() {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Multiple importance sampling
+
+/// The power heuristic is `a² / (a² + b²)` (Veach's β = 2), the weights of the two techniques sum
+/// to 1, and the edges its documentation promises hold: 0 for a zero density, even against another
+/// zero one (where the ratio is 0/0), 1 for an infinite one, and no overflow for huge densities.
+#[test]
+fn power_heuristic_matches_its_closed_form_and_edges() {
+    use lumiere::sampling::mis::power_heuristic;
+    let mut rng = TestRng(131);
+    for _ in 0..10_000 {
+        let (a, b) = (rng.range(0.0, 10.0), rng.range(0.0, 10.0));
+        let (a2, b2) = ((a as f64).powi(2), (b as f64).powi(2));
+        let w = power_heuristic(a, b);
+        assert!((w as f64 - a2 / (a2 + b2)).abs() < 1e-6, "w({a}, {b}) = {w}");
+        assert!((w + power_heuristic(b, a) - 1.0).abs() < 1e-6, "w({a}, {b}) + w({b}, {a})");
+    }
+    assert_eq!(power_heuristic(0.0, 3.0), 0.0);
+    assert_eq!(power_heuristic(0.0, 0.0), 0.0);
+    // The guard treats an undefined density as zero too.
+    assert_eq!(power_heuristic(f32::NAN, 1.0), 0.0);
+    assert_eq!(power_heuristic(f32::INFINITY, 5.0), 1.0);
+    assert_eq!(power_heuristic(3.0, f32::INFINITY), 0.0);
+    assert_eq!(power_heuristic(1e30, 1e30), 0.5);
+    assert_eq!(power_heuristic(1e-30, 1e-30), 0.5);
+}
+
+// ---------------------------------------------------------------------------------------------
 // Samplers
 
 const KINDS: [SamplerKind; 2] = [SamplerKind::Independent, SamplerKind::Sobol];

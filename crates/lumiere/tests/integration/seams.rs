@@ -161,6 +161,36 @@ fn colours_and_normals_that_are_not_finite_are_refused() {
     assert_eq!(error.to_string(), "lights: normal 1 is not finite");
 }
 
+/// Power choice gives each light its share of the total flux, `π A Σ Ke` over the channels: both
+/// when the sums fit in `f32` and when one light's overflows and is taken in `f64`. The frequency
+/// test above compares choices with `choice_pmf` only, and the overflow test only asks that the
+/// huge light wins, so neither sees a weight that is off by a factor.
+#[test]
+fn power_choice_follows_each_lights_flux_even_past_f32() {
+    for ke in [2.0f32, 1e38] {
+        let mut scene = light_scene();
+        scene.materials[1].ke = Vec3::splat(ke);
+        let lights = LightSet::new(&scene);
+        let flux: Vec<f64> = lights
+            .lights()
+            .iter()
+            .map(|l| {
+                let [a, b, c] = l.vertices.map(|v| v.as_dvec3());
+                let emission = l.emission.as_dvec3();
+                PI * 0.5 * (b - a).cross(c - a).length() * (emission.x + emission.y + emission.z)
+            })
+            .collect();
+        let total: f64 = flux.iter().sum();
+        for (index, flux) in flux.iter().enumerate() {
+            let (pmf, expected) = (lights.choice_pmf(LightSelection::Power, index as u32) as f64, flux / total);
+            assert!(
+                (pmf - expected).abs() <= 1e-5 * expected,
+                "Ke {ke}, light {index}: pmf {pmf}, expected {expected}"
+            );
+        }
+    }
+}
+
 /// Light choice by power and uniformly: observed frequencies match `choice_pmf`.
 #[test]
 fn light_choice_frequencies_match_their_pmf() {
