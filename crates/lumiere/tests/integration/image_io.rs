@@ -117,7 +117,11 @@ fn exr_bytes_do_not_depend_on_the_order_tiles_finish_in() {
     let pixels: Vec<Vec3> = (0..w * h)
         .map(|i| {
             let (x, y) = (i % w, i / w);
-            if (x / 64 + y / 64) % 2 == 0 { Vec3::splat(0.5) } else { Vec3::splat(((i * 2_654_435_761) >> 8) as f32) }
+            if (x / 64 + y / 64) % 2 == 0 {
+                Vec3::splat(0.5)
+            } else {
+                Vec3::splat((i.wrapping_mul(2_654_435_761) >> 8) as f32)
+            }
         })
         .collect();
     let layer = ExrLayer { name: "albedo", channels: &["R", "G", "B"], pixels: &pixels };
