@@ -63,11 +63,15 @@ fn stopping_at_s_samples_equals_asking_for_s() {
     assert_eq!(stopped.film, asked.film);
 }
 
+/// Ambient occlusion until the relative error is 5% (a few passes at 48x36).
+fn to_noise_target() -> RenderOptions {
+    RenderOptions { spp: 10_000, noise_target: Some(0.05), ..RenderOptions::new(Technique::ambient_occlusion(8)) }
+}
+
 #[test]
 fn noise_target_stops_early_with_the_error_reached() {
     let (world, camera) = small_world();
-    let options =
-        RenderOptions { spp: 10_000, noise_target: Some(0.05), ..RenderOptions::new(Technique::ambient_occlusion(8)) };
+    let options = to_noise_target();
     let out = render(&world, &camera, &options, &|_| {}).unwrap();
     assert_eq!(out.stop, StopReason::NoiseTarget);
     assert!(out.film.samples < 10_000);
@@ -83,8 +87,7 @@ fn noise_target_stops_early_with_the_error_reached() {
 #[test]
 fn a_resumed_film_that_meets_its_noise_target_gets_no_further_pass() {
     let (world, camera) = small_world();
-    let options =
-        RenderOptions { spp: 10_000, noise_target: Some(0.05), ..RenderOptions::new(Technique::ambient_occlusion(8)) };
+    let options = to_noise_target();
     let done = render(&world, &camera, &options, &|_| {}).unwrap();
     assert_eq!(done.stop, StopReason::NoiseTarget);
 
