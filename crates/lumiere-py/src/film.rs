@@ -52,7 +52,8 @@ pub fn render_passes<'py>(
         let (world, camera, options) = (&*world, &camera, &options);
         pool.install(|| render_pass_range(world, camera, options, first, count, &|n| watch.count(n), &watch.cancel))
     })?;
-    passes.iter().map(|p| Ok((p.sample, to_bytearray(py, &p.values)?, p.rays))).collect()
+    // Each pass is dropped once copied, so that the task's peak is its passes once, not twice.
+    passes.into_iter().map(|p| Ok((p.sample, to_bytearray(py, &p.values)?, p.rays))).collect()
 }
 
 /// A film that passes are added to in order, with the render's totals.

@@ -51,6 +51,7 @@ def from_arrays(**kwargs):
         (lambda: lumiere.Scene.from_arrays([[0, 0, "x"]], [[0, 0, 0]]), "vertices must be an array of numbers"),
         (lambda: lumiere.write_image("x.png", np.array([[[None] * 3]])), "image must hold numbers, got an array of object"),
         (lambda: lumiere.write_image("x.png", [[["1", "2", "3"]]]), "image must hold numbers, got an array of <U1"),
+        (lambda: lumiere.write_image("x.png", np.zeros((0, 2**33, 3), np.float32)), "image size 8589934592x0 is too large"),
         (lambda: _lumiere.NativeFilm(-1, 2), "width must be an integer between 0 and 4294967295, got -1"),
         (lambda: _lumiere.NativeFilm(2, 2**64), "height must be an integer between 0 and 4294967295"),
     ],

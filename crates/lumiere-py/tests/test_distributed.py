@@ -5,6 +5,7 @@ cluster answers."""
 
 import os
 import signal
+import struct
 import subprocess
 import sys
 import threading
@@ -26,6 +27,12 @@ from conftest import read_pfm  # noqa: E402
 
 def bits(image):
     return np.ascontiguousarray(image, dtype=np.float32).view(np.uint32)
+
+
+def checkpoint_header(path):
+    """A checkpoint's samples per pixel and rendering seconds (the layout in checkpoint.rs)."""
+    head = path.read_bytes()[:72]
+    return struct.unpack_from("<I", head, 36)[0], struct.unpack_from("<d", head, 64)[0]
 
 
 @pytest.fixture(scope="module")
@@ -75,22 +82,26 @@ def _render_processes():
     return pids
 
 
+def _kill_a_rendering_worker(killed, after):
+    """Kills (SIGKILL) the first worker seen running a lumiere task, ``after`` seconds later if it
+    still runs one, within a minute; its pid goes to ``killed``."""
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and not killed:
+        for pid in _render_processes():
+            time.sleep(after)
+            if pid in _render_processes():
+                os.kill(pid, signal.SIGKILL)
+                killed.append(pid)
+            break
+        time.sleep(0.05)
+
+
 def test_a_worker_killed_mid_task_changes_nothing(cluster):
     scene = lumiere.builtin()
     options = dict(spp=96, size=(96, 72), seed=2)
     local = lumiere.render(scene, **options)
     killed = []
-
-    def kill_one():
-        deadline = time.monotonic() + 60
-        while time.monotonic() < deadline and not killed:
-            for pid in _render_processes():
-                os.kill(pid, signal.SIGKILL)
-                killed.append(pid)
-                break
-            time.sleep(0.05)
-
-    killer = threading.Thread(target=kill_one)
+    killer = threading.Thread(target=_kill_a_rendering_worker, args=(killed, 0))
     killer.start()
     result = distributed.render_full(scene, address=cluster.address, tasks=4, max_retries=3, **options)
     killer.join()
@@ -111,6 +122,84 @@ def test_the_merged_checkpoint_resumes_in_the_cli(cluster, cli, tmp_path):
     assert np.array_equal(bits(resumed), bits(straight))
     with pytest.raises(lumiere.LumiereError, match="seed"):
         distributed.render(scene, spp=8, seed=1, size=(32, 24), address=cluster.address, checkpoint=str(checkpoint), resume=True)
+
+
+def test_no_task_holds_more_than_its_bytes_of_passes(cluster, monkeypatch):
+    scene = lumiere.builtin()
+    local = lumiere.render(scene, spp=10, size=(32, 24), seed=3)
+    # Three passes of 32x24 per task at most: one task asked for, four given.
+    monkeypatch.setattr(distributed, "TASK_BYTES", 12 * 32 * 24 * 3)
+    result = distributed.render_full(scene, spp=10, size=(32, 24), seed=3, address=cluster.address, tasks=1)
+    assert [task["passes"] for task in result.stats["tasks"]] == [2, 3, 2, 3]
+    assert np.array_equal(bits(result.image), bits(local))
+
+
+def test_checkpoints_hold_the_seconds_so_far_and_replace_a_film_only_with_a_larger_one(cluster, tmp_path, monkeypatch):
+    checkpoint = tmp_path / "render.ckpt"
+    scene = lumiere.builtin()
+    distributed.render(scene, spp=2, size=(32, 24), address=cluster.address, checkpoint=str(checkpoint))
+    assert checkpoint_header(checkpoint)[0] == 2
+    # A new render over it, saving as often as it may, stopped halfway: the file is only ever
+    # replaced by a film with samples (it was rewritten with an empty one while the first task ran),
+    # and it holds the seconds rendered so far (it held those of earlier sessions only: 0 here).
+    monkeypatch.setattr(distributed, "WAIT_SECONDS", 0.001)
+    seen = []
+
+    class Stop(Exception):
+        pass
+
+    def progress(done, total):
+        seen.append(checkpoint_header(checkpoint)[0])
+        if done * 2 >= total:
+            raise Stop
+
+    with pytest.raises(Stop):
+        distributed.render(scene, spp=8, size=(32, 24), address=cluster.address, tasks=8, checkpoint=str(checkpoint),
+                           checkpoint_every=0, progress=progress)
+    assert seen and 0 not in seen, seen
+    samples, seconds = checkpoint_header(checkpoint)
+    assert samples >= 4 and seconds > 0
+
+
+def test_a_scene_file_a_worker_cannot_read_is_named(cluster, tmp_path):
+    obj = tmp_path / "gone.obj"
+    obj.write_text("v -1 0 -1\nv 1 0 -1\nv 1 0 1\nf 1 3 2\n")
+    scene = lumiere.load(obj)
+    obj.unlink()
+    camera = lumiere.Camera.look_at((0, 1, 4), (0, 0, 0), size=(8, 6))
+    with pytest.raises(lumiere.LumiereError, match=f"the worker on .* could not load the scene: {obj}: No such file"):
+        distributed.render(scene, camera, mode="hits", spp=2, address=cluster.address, tasks=2)
+
+
+def test_a_task_larger_than_every_node_is_refused(cluster):
+    # Ray would wait forever for a node with two CPUs.
+    with pytest.raises(lumiere.LumiereError, match=r"threads_per_task=2 is more CPUs than any node of the cluster has \(at most 1\)"):
+        distributed.render(lumiere.builtin(), spp=2, size=(8, 6), address=cluster.address, threads_per_task=2)
+
+
+def test_a_worker_of_another_version_or_options_is_refused():
+    scene = lumiere.builtin()
+    camera = lumiere.Camera.builtin((8, 6))
+    ours = lumiere._render._options("path", 2, 0, None, None, None, {}).describe(camera._native)
+    result = {"host": "node7", "version": lumiere.__version__, "fingerprint": scene.fingerprint, "options": ours}
+    distributed._check_result(result, scene, ours)
+    with pytest.raises(lumiere.LumiereError, match="the worker on node7 runs lumiere 0.0.1, this process"):
+        distributed._check_result(result | {"version": "0.0.1"}, scene, ours)
+    other = lumiere._render._options("path", 2, 1, None, None, None, {}).describe(camera._native)
+    with pytest.raises(lumiere.LumiereError, match="the worker on node7 would render another image: its seed differ"):
+        distributed._check_result(result | {"options": other}, scene, ours)
+
+
+def test_a_worker_that_dies_past_its_retries_is_a_task_failure(cluster):
+    killed = []
+    # Well inside its task: Ray reruns a task whose worker died before it began, whatever
+    # max_retries says.
+    killer = threading.Thread(target=_kill_a_rendering_worker, args=(killed, 0.3))
+    killer.start()
+    with pytest.raises(distributed.TaskFailed, match=r"the task of passes (0 to 95|96 to 191) failed: \w+: "):
+        distributed.render(lumiere.builtin(), spp=192, size=(96, 72), address=cluster.address, tasks=2, max_retries=0)
+    killer.join()
+    assert killed
 
 
 def test_an_edited_scene_file_renders_again_and_a_stale_one_is_named(cluster, tmp_path):
@@ -192,3 +281,8 @@ def test_bad_arguments_are_refused_before_connecting(tmp_path):
         distributed.render(lumiere.builtin(), spp=2, tasks=0, address="127.0.0.1:9")
     with pytest.raises(lumiere.LumiereError, match="threads_per_task must be at most 1024"):
         distributed.render(lumiere.builtin(), spp=2, threads_per_task=5000, address="127.0.0.1:9")
+    # Both were found out only on a cluster (the first once tasks were running), or never.
+    with pytest.raises(TypeError, match="progress must be callable"):
+        distributed.render(lumiere.builtin(), spp=2, progress=5, address="127.0.0.1:9")
+    with pytest.raises(lumiere.LumiereError, match="resume needs the checkpoint"):
+        distributed.render(lumiere.builtin(), spp=2, resume=True, address="127.0.0.1:9")

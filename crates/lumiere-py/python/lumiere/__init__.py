@@ -56,6 +56,9 @@ def write_image(path: str, image: "object", exposure: float = 0.0, tonemap: str 
     if array.ndim != 3 or array.shape[2] != 3:
         raise LumiereError(f"image must have shape (height, width, 3), got {array.shape}")
     height, width = array.shape[:2]
+    # A side the writers' u32 cannot hold (an empty array can have one) is an error, not an overflow.
+    if max(width, height) > 2**32 - 1:
+        raise LumiereError(f"image size {width}x{height} is too large: at most 4294967295 pixels a side")
     _write_image(_path(path), width, height, array.tobytes(), _number(exposure, "exposure"), _text(tonemap, "tonemap"))
 
 

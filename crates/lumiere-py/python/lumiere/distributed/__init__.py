@@ -16,6 +16,7 @@ Needs Ray: ``pip install 'lumiere[ray]'``. See docs/DISTRIBUTED.md for measureme
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import socket
@@ -26,14 +27,28 @@ import numpy as np
 
 from .. import _lumiere
 from .._render import Progress, RenderResult, _array, _camera, _options
-from .._scene import Camera, Scene, _integer, _path
+from .._scene import Camera, Scene, _integer, _path, _rebuild_camera, _rebuild_scene
 from ..errors import LumiereError
 
-__all__ = ["ClusterUnreachable", "connect", "render", "render_full", "split_passes"]
+__all__ = ["ClusterUnreachable", "TaskFailed", "connect", "render", "render_full", "split_passes"]
+
+#: The most bytes of passes one task holds (12 per pixel and pass): a task keeps its passes until
+#: it returns them, so a long render of a large image is split into more tasks than asked for
+#: rather than one that exhausts a worker's memory.
+TASK_BYTES = 256 << 20
+
+#: How long the driver waits for the next task's passes before it reports progress again (and
+#: Python sees a Ctrl-C).
+WAIT_SECONDS = 0.5
 
 
 class ClusterUnreachable(ConnectionError):
     """No Ray cluster answers at the address given."""
+
+
+class TaskFailed(RuntimeError):
+    """A task failed on the cluster for a reason other than its inputs: its worker died more often
+    than ``max_retries`` allows, or Ray itself failed."""
 
 
 def _ray() -> Any:
@@ -99,17 +114,33 @@ def split_passes(first: int, end: int, tasks: int) -> List[Tuple[int, int]]:
 
 
 def _render_range(
-    scene: Scene, camera: Camera, option_args: Dict[str, Any], first: int, count: int, threads: int
+    scene_recipe: tuple, camera_recipe: tuple, option_args: Dict[str, Any], first: int, count: int, threads: int
 ) -> Dict[str, Any]:
-    """The Ray task: passes ``first .. first + count``, each as ``(sample, float32 array, rays)``."""
+    """The Ray task: passes ``first .. first + count``, each as ``(sample, float32 array, rays)``.
+
+    The scene and camera come as their recipes and are rebuilt here, in the task, rather than
+    unpickled by Ray while it prepares the task's arguments: a file missing on this node is then
+    an error naming the node and the file, not a Ray system error."""
     start, cpu = time.perf_counter(), time.process_time()
+    host = socket.gethostname()
+    try:
+        scene, camera = _rebuild_scene(scene_recipe), _rebuild_camera(camera_recipe)
+    except LumiereError as e:
+        raise LumiereError(
+            f"the worker on {host} could not load the scene: {e} (is every file the render reads "
+            "on every node, at the same path?)"
+        ) from None
     options = _lumiere.NativeOptions(**option_args)
     passes = _lumiere.render_passes(scene._native, camera._native, options, first, count, threads)
     return {
         "first": first,
         "passes": [(sample, np.frombuffer(values, dtype=np.float32), rays) for sample, values, rays in passes],
         "fingerprint": scene.fingerprint,
-        "host": socket.gethostname(),
+        # What decides the samples' values besides the scene, and the version that computes them:
+        # a driver that checks them needs no trust in the nodes' installs.
+        "options": options.describe(camera._native),
+        "version": _lumiere.__version__,
+        "host": host,
         "pid": os.getpid(),
         "seconds": time.perf_counter() - start,
         # The worker process runs one task at a time: its CPU time is this task's.
@@ -135,6 +166,48 @@ def _different_scene(scene: Scene, host: str) -> str:
         )
     made = "the built-in scene" if scene.is_builtin else "the same arrays"
     return f"{scene.name}: the worker on {host} built a different scene from {made} (is the same lumiere version installed on every node?)"
+
+
+def _check_result(result: Dict[str, Any], scene: Scene, options: str) -> None:
+    """Refuses a task's passes when its worker rendered another image than this process would:
+    another lumiere version, another scene, or other options or camera (``options`` is this
+    process's description of them)."""
+    host = result["host"]
+    if result["version"] != _lumiere.__version__:
+        raise LumiereError(
+            f"the worker on {host} runs lumiere {result['version']}, this process {_lumiere.__version__}: "
+            "install the same version on every node"
+        )
+    if result["fingerprint"] != scene.fingerprint:
+        raise LumiereError(_different_scene(scene, host))
+    if result["options"] != options:
+        ours = set(options.splitlines())
+        differing = [line.partition(":")[0] for line in result["options"].splitlines() if line not in ours]
+        raise LumiereError(
+            f"the worker on {host} would render another image: its {', '.join(differing)} differ from this "
+            "process's (is another build of lumiere installed on that node?)"
+        )
+
+
+def _check_threads_per_task(ray: Any, threads_per_task: int) -> None:
+    """Refuses tasks larger than every node: Ray would wait for such a node forever."""
+    largest = max((node["Resources"].get("CPU", 0) for node in ray.nodes() if node["Alive"]), default=0)
+    if threads_per_task > largest:
+        raise LumiereError(
+            f"threads_per_task={threads_per_task} is more CPUs than any node of the cluster has (at most {largest:g})"
+        )
+
+
+def _result(ray: Any, ref: Any, first: int, count: int) -> Dict[str, Any]:
+    """The task's result; its own error (a scene a worker cannot read) as it was raised there."""
+    try:
+        return ray.get(ref)
+    except ray.exceptions.RayError as e:
+        cause = e.cause if isinstance(e, ray.exceptions.RayTaskError) else e
+        if isinstance(cause, LumiereError):
+            raise cause from None
+        why = (str(cause).splitlines() or [""])[0]
+        raise TaskFailed(f"the task of passes {first} to {first + count - 1} failed: {type(cause).__name__}: {why}") from e
 
 
 def render_full(
@@ -171,6 +244,10 @@ def render_full(
             and (not isinstance(checkpoint_every, int) or abs(checkpoint_every) < 2**1023)
             and math.isfinite(checkpoint_every) and checkpoint_every >= 0):
         raise LumiereError(f"checkpoint_every must be a finite number of seconds, at least 0, got {checkpoint_every!r}")
+    if progress is not None and not callable(progress):
+        raise TypeError(f"progress must be callable as progress(done, total), got {type(progress).__name__}")
+    if resume and checkpoint is None:
+        raise LumiereError("resume needs the checkpoint to resume from")
     # Refused now, not once the render is done and the checkpoint cannot hold it.
     if checkpoint is not None:
         checkpoint = _path(checkpoint)
@@ -185,55 +262,71 @@ def render_full(
     if checkpoint is not None:
         _check_outputs([("checkpoint", checkpoint)], scene, "scene", camera, "camera")
     width, height = camera.size
-    if resume and checkpoint is not None and os.path.exists(checkpoint):
+    if resume and os.path.exists(checkpoint):
         film = _lumiere.NativeFilm.load_checkpoint(checkpoint, scene._native, camera._native, options)
     else:
         film = _lumiere.NativeFilm(width, height)
     if film.samples > spp:
         raise LumiereError(f"{checkpoint}: the checkpoint has {film.samples} samples per pixel, more than spp={spp}")
     ray = connect(address)
+    _check_threads_per_task(ray, threads_per_task)
     start = time.perf_counter()
     cpus = max(1, int(ray.cluster_resources().get("CPU", 1) // max(1, threads_per_task)))
     # A few tasks per CPU: the last ones to finish keep every worker busy till the end.
-    ranges = split_passes(film.samples, spp, tasks or 4 * cpus)
+    wanted = tasks or 4 * cpus
+    passes_per_task = max(1, TASK_BYTES // (12 * width * height))
+    ranges = split_passes(film.samples, spp, max(wanted, math.ceil((spp - film.samples) / passes_per_task)))
     task = ray.remote(_render_range).options(num_cpus=threads_per_task, max_retries=max_retries)
-    scene_ref, camera_ref = ray.put(scene), ray.put(camera)
-    pending = {task.remote(scene_ref, camera_ref, option_args, first, count, threads_per_task): (first, count) for first, count in ranges}
-    done: Dict[int, Dict[str, Any]] = {}
+    scene_ref, camera_ref = ray.put(scene._recipe), ray.put(camera._recipe)
+    # By first pass. Results are fetched in pass order, one at a time, so that the driver holds
+    # one task's passes at most; the others wait in Ray's object store.
+    pending = {
+        first: (task.remote(scene_ref, camera_ref, option_args, first, count, threads_per_task), count)
+        for first, count in ranges
+    }
+    description = options.describe(camera._native)
     records: List[Dict[str, Any]] = []
     pixels = width * height
+    earlier_seconds, saved_samples = film.seconds, film.samples
     last_checkpoint = time.monotonic()
+
+    def save() -> None:
+        nonlocal saved_samples, last_checkpoint
+        film.seconds = earlier_seconds + (time.perf_counter() - start)
+        film.save_checkpoint(checkpoint, scene._native, camera._native, options)
+        saved_samples, last_checkpoint = film.samples, time.monotonic()
+
     try:
-        while pending:
-            ready, _ = ray.wait(list(pending), num_returns=1, timeout=0.5)
-            for ref in ready:
-                pending.pop(ref)
-                result = ray.get(ref)
-                if result["fingerprint"] != scene.fingerprint:
-                    raise LumiereError(_different_scene(scene, result["host"]))
-                done[result["first"]] = result
-                records.append(
-                    {k: result[k] for k in ("first", "seconds", "cpu_seconds", "host", "pid")} | {"passes": len(result["passes"])}
-                )
-            # Add whole tasks in pass order as soon as the next one is there.
-            while film.samples in done:
-                for sample, values, rays in done.pop(film.samples)["passes"]:
+        while film.samples < spp:
+            ref, count = pending[film.samples]
+            if ray.wait([ref], num_returns=1, timeout=WAIT_SECONDS)[0]:
+                first = film.samples
+                result = _result(ray, ref, first, count)
+                _check_result(result, scene, description)
+                for sample, values, rays in result["passes"]:
                     film.add_pass(sample, values.tobytes(), rays)
+                records.append({k: result[k] for k in ("first", "seconds", "cpu_seconds", "host", "pid")} | {"passes": count})
+                del pending[first], result
             if progress is not None:
                 progress(film.samples * pixels, spp * pixels)
-            if checkpoint is not None and time.monotonic() - last_checkpoint >= checkpoint_every:
-                film.save_checkpoint(checkpoint, scene._native, camera._native, options)
-                last_checkpoint = time.monotonic()
+            # Only a film that has grown: an unchanged one (or an empty one over an older
+            # checkpoint) is not written again.
+            if checkpoint is not None and film.samples > saved_samples and time.monotonic() - last_checkpoint >= checkpoint_every:
+                save()
     except BaseException:
-        for ref in pending:
-            ray.cancel(ref, force=True)
-        if checkpoint is not None and film.samples > 0:
-            film.save_checkpoint(checkpoint, scene._native, camera._native, options)
+        # The film first: cancelling needs the cluster, which may be what failed.
+        try:
+            if checkpoint is not None and film.samples > saved_samples:
+                save()
+        finally:
+            for ref, _ in pending.values():
+                # The error being raised is what the caller must see, not a failed cancel's.
+                with contextlib.suppress(Exception):
+                    ray.cancel(ref, force=True)
         raise
     seconds = time.perf_counter() - start
-    film.seconds = film.seconds + seconds
     if checkpoint is not None:
-        film.save_checkpoint(checkpoint, scene._native, camera._native, options)
+        save()
     stats = {
         "samples": film.samples,
         "rays": film.rays,
@@ -269,13 +362,14 @@ def render(
     scene, camera and options, bit for bit.
 
     :param address: the cluster (see :func:`connect`); None starts a local Ray instance.
-    :param tasks: how many tasks to split the passes into (default 4 per CPU of the cluster).
-    :param threads_per_task: CPUs (and threads) each task takes.
+    :param tasks: how many tasks to split the passes into (default 4 per CPU of the cluster; more
+        where a task's passes would hold more than :data:`TASK_BYTES`).
+    :param threads_per_task: CPUs (and threads) each task takes; no more than a node has.
     :param max_retries: times Ray reruns a task whose worker died (the bytes do not change).
-    :param checkpoint: a file where the merged film is saved every ``checkpoint_every`` seconds,
-        on interruption and at the end, in the CLI's format (``lumiere render --resume`` reads it).
+    :param checkpoint: a file where the merged film is saved every ``checkpoint_every`` seconds
+        (when it has grown), on interruption and at the end, in the CLI's format (``lumiere render --resume`` reads it).
     :param resume: continue from ``checkpoint`` when it exists (same scene and options; more
-        ``spp`` is fine).
+        ``spp`` is fine); needs ``checkpoint``.
     :param progress: ``progress(done, total)`` in pixel samples, as passes are merged.
 
     Budgets (``time``, ``noise``) are not offered: a distributed render does a fixed number of

@@ -10,7 +10,7 @@ from typing import List, Optional
 
 from .. import Camera, LumiereError, _lumiere, builtin, load, write_image
 from .._scene import _first_repeat
-from . import ClusterUnreachable, _check_outputs, render_full
+from . import ClusterUnreachable, TaskFailed, _check_outputs, render_full
 
 #: ``lumiere render``'s exit code for bad input.
 EXIT_ERROR = 2
@@ -143,6 +143,9 @@ def main(argv: Optional[List[str]] = None) -> int:
     except (LumiereError, ClusterUnreachable, ImportError) as e:
         print(f"lumiere.distributed: error: {e}", file=sys.stderr)
         return EXIT_ERROR
+    except TaskFailed as e:
+        print(f"lumiere.distributed: error: {e}", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         print("lumiere.distributed: interrupted", file=sys.stderr)
         return 130
