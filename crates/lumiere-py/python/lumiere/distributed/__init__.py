@@ -285,7 +285,7 @@ def render_full(
         for first, count in ranges
     }
     description = options.describe(camera._native)
-    records: List[Dict[str, Any]] = []
+    records: List[Dict[str, Any]] = []  # in pass order, as merged
     pixels = width * height
     earlier_seconds, saved_samples = film.seconds, film.samples
     last_checkpoint = time.monotonic()
@@ -333,7 +333,7 @@ def render_full(
         "seconds": seconds,
         "discarded": film.discarded,
         "relative_error": film.relative_error(),
-        "tasks": sorted(records, key=lambda r: r["first"]),
+        "tasks": records,
         "cpus": cpus,
     }
     return RenderResult(_array(film.image(), height, width), {}, stats)
