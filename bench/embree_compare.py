@@ -187,8 +187,10 @@ def versions() -> str:
         except PackageNotFoundError:
             parts.append(f"{pkg} ?")
     try:
-        rev = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, check=True)
-        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], capture_output=True, text=True)
+        # The repository's commit, wherever the script is run from.
+        repo = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+        rev = subprocess.run(["git", "-C", repo, "rev-parse", "--short", "HEAD"], capture_output=True, text=True, check=True)
+        dirty = subprocess.run(["git", "-C", repo, "status", "--porcelain", "--untracked-files=no"], capture_output=True, text=True)
         parts.append(f"lumiere {rev.stdout.strip()}{' (modified)' if dirty.stdout.strip() else ''}")
     except (OSError, subprocess.CalledProcessError):
         pass

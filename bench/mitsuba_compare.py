@@ -294,15 +294,20 @@ def machine() -> str:
     return f"{model}, {os.cpu_count()} logical cores ({usable} usable), {platform.system()} {platform.release()}"
 
 
-def lumiere_commit() -> str:
+def lumiere_commit(binary: str) -> str:
+    """The work tree's commit for its own build; for another binary its path beside it, since a
+    binary cannot say which commit it was built from."""
     try:
         rev = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, check=True,
                              cwd=REPO)
         dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], capture_output=True,
                                text=True, cwd=REPO)
-        return rev.stdout.strip() + (" (modified)" if dirty.stdout.strip() else "")
+        commit = rev.stdout.strip() + (" (modified)" if dirty.stdout.strip() else "")
     except (OSError, subprocess.CalledProcessError):
-        return "unknown"
+        commit = "unknown"
+    if Path(binary).resolve() != (REPO / "target" / "release" / "lumiere").resolve():
+        return f"binary {binary} (not this work tree's build, which is at {commit})"
+    return commit
 
 
 def find_libllvm() -> str | None:
@@ -373,7 +378,7 @@ def main() -> int:
     command = shlex.join(["python3", *sys.argv])
     started = datetime.datetime.now().astimezone()
     load = os.getloadavg()[0]
-    commit = lumiere_commit()
+    commit = lumiere_commit(args.lumiere)
 
     # --- Scene --------------------------------------------------------------------------------
     log(f"scene: {CORNELL / 'cornell.obj'} split by material into {out}")

@@ -25,7 +25,7 @@ import sys
 import tempfile
 
 # The side-by-side script's helpers (this folder is on the import path when a script here runs).
-from embree_side_by_side import git_commit, progress
+from embree_side_by_side import lumiere_build, progress
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -95,7 +95,7 @@ def main():
 
     print(f"`python3 bench/staircase_per_bounce.py --repeats {args.repeats} --threads {args.threads} "
           f"--spp {args.spp}{' --full' if args.full else ''}` on **{started:%Y-%m-%d %H:%M} UTC**, "
-          f"lumiere at `{git_commit()}`; load average {load_before:.2f} before, {load_after:.2f} after; "
+          f"lumiere at {lumiere_build(args.lumiere)}; load average {load_before:.2f} before, {load_after:.2f} after; "
           f"medians of {args.repeats}, {args.threads} threads, `--mode path --spp {args.spp}`:")
     print()
     print("| scene | size | render ms (median) | runs (ms) | rays | ns per ray |")

@@ -82,10 +82,24 @@ pub fn mismatches(binary: &Bvh, wide: &Accel, set: &RaySet) -> usize {
         .count()
 }
 
-/// Peak resident memory of this process so far (Linux `VmHWM`), in MiB, if known.
+/// Peak resident memory of this process (Linux `VmHWM`) since the last [`reset_peak_rss`], in
+/// MiB, if known.
 pub fn peak_rss_mib() -> Option<f64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
     let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
     let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
     Some(kib / 1024.0)
+}
+
+/// Starts a new peak at the memory in use now (Linux 4.0 and later), so that each scene's peak is
+/// its own, not the largest scene's before it (the process's where it cannot).
+pub fn reset_peak_rss() {
+    // Memory freed by the scenes before, which the allocator would keep and count in this scene's
+    // peak, goes back to the system first.
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    // SAFETY: malloc_trim only hands free pages of the heap back to the system.
+    unsafe {
+        libc::malloc_trim(0);
+    }
+    let _ = std::fs::write("/proc/self/clear_refs", "5");
 }

@@ -2,7 +2,9 @@
 
 use std::time::Instant;
 
-use crate::bench::bvh::{build, median_seconds, mesh_bytes, mismatches, peak_rss_mib, trace, work_per_ray};
+use crate::bench::bvh::{
+    build, median_seconds, mesh_bytes, mismatches, peak_rss_mib, reset_peak_rss, trace, work_per_ray,
+};
 use crate::bench::rays::make_ray_sets;
 use crate::bench::scenes::BenchScene;
 use lumiere::accel::{BuildPreset, Bvh};
@@ -38,6 +40,7 @@ pub fn run(args: &BenchBvhArgs) -> Result<()> {
     let mut traces = Vec::new();
     let mut json = Vec::new();
     for bench in &scenes {
+        reset_peak_rss();
         let start = Instant::now();
         let scene = bench.load(&args.scenes_dir)?;
         let load_ms = start.elapsed().as_secs_f64() * 1e3;
@@ -105,7 +108,7 @@ pub fn run(args: &BenchBvhArgs) -> Result<()> {
         }
     }
     output::print(
-        "| scene | threads | triangles | references | load ms | build ms | nodes binary / wide | SAH fast / default / high | bytes/tri | peak RSS MiB |",
+        "| scene | threads | triangles | references | load ms | build ms | nodes binary / wide | SAH fast / default / high | bytes/tri | peak RSS MiB (during the scene) |",
     )?;
     output::print("|---|---|---|---|---|---|---|---|---|---|")?;
     for row in &builds {

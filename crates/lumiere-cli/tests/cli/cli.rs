@@ -395,10 +395,19 @@ fn staircase_emission_turns_many_small_emitters_into_lights() {
 
 #[test]
 fn lab_bench_quick_prints_every_row() {
-    let run = lumiere(&["bench", "--quick"]);
+    let dir = TempDir::new("bench");
+    let json = dir.path("bench.json");
+    let run = lumiere(&["bench", "--quick", "--json", json.to_str().unwrap()]);
     assert!(run.status.success(), "{}", stderr(&run));
     let table = String::from_utf8_lossy(&run.stdout);
     for row in ["hard shadows", "soft shadows N=16", "soft shadows N=256", "AO N=16", "AO N=256"] {
         assert!(table.contains(&format!("| {row} |")), "missing {row}:\n{table}");
+    }
+    // Nor does the JSON set the lab's 1024x768 figures beside the 256x192 times.
+    let rows: Vec<serde_json::Value> = serde_json::from_slice(&fs::read(&json).unwrap()).unwrap();
+    assert_eq!(rows.len(), 7);
+    for row in &rows {
+        assert_eq!((row["width"].as_u64(), row["parallel_ms"].is_f64()), (Some(256), true), "{row}");
+        assert!(row["lab_parallel_ms"].is_null() && row["lab_serial_ms"].is_null(), "{row}");
     }
 }
