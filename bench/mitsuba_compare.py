@@ -17,6 +17,7 @@ from __future__ import annotations
 import argparse
 import datetime
 import glob
+import hashlib
 import json
 import math
 import os
@@ -420,7 +421,14 @@ def main() -> int:
                     for name in mitsuba_samplers}
 
     # --- Reference ----------------------------------------------------------------------------
-    ref_path = cache / f"mitsuba-{mi.__version__}-cornell-{width}x{height}-d{args.max_depth}-{args.ref_spp}spp.exr"
+    # Keyed by everything the reference depends on besides the names above (the scene's files and
+    # materials, the camera, the integrator's settings), so that no change reuses a stale one.
+    key = hashlib.sha256(repr(([(s["kd"].tolist(), s["ke"].tolist(), s["flip"]) for s in shapes],
+                               eye.tolist(), target.tolist(), up.tolist(), integrator)).encode())
+    for shape in shapes:
+        key.update(Path(shape["path"]).read_bytes())
+    ref_path = cache / (f"mitsuba-{mi.__version__}-cornell-{width}x{height}-d{args.max_depth}-{args.ref_spp}spp-"
+                        f"{key.hexdigest()[:12]}.exr")
     meta_path = ref_path.with_suffix(".json")
     if ref_path.exists() and meta_path.exists():
         ref = read_exr(ref_path)

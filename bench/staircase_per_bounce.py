@@ -19,6 +19,7 @@ import argparse
 import datetime
 import json
 import os
+import shlex
 import statistics
 import subprocess
 import sys
@@ -93,8 +94,7 @@ def main():
             full_ms, _ = render(args.lumiere, scenes[1][1], "720x1280", 64, args.threads, workdir)
     load_after = os.getloadavg()[0]
 
-    print(f"`python3 bench/staircase_per_bounce.py --repeats {args.repeats} --threads {args.threads} "
-          f"--spp {args.spp}{' --full' if args.full else ''}` on **{started:%Y-%m-%d %H:%M} UTC**, "
+    print(f"`{shlex.join(['python3', *sys.argv])}` on **{started:%Y-%m-%d %H:%M} UTC**, "
           f"lumiere at {lumiere_build(args.lumiere)}; load average {load_before:.2f} before, {load_after:.2f} after; "
           f"medians of {args.repeats}, {args.threads} threads, `--mode path --spp {args.spp}`:")
     print()
@@ -111,7 +111,7 @@ def main():
     verdict = "met per ray" if ratio <= TARGET_RATIO else "not met"
     print()
     print(f"Staircase against the box, per ray: **{ratio:.2f}x** (target {TARGET_RATIO:g}x per path segment: "
-          f"{verdict}; per segment about 4% higher, see bench/README.md).")
+          f"{verdict}; not measured here: per segment, earlier runs measured it about 4% higher, see bench/README.md).")
     if full_ms is not None:
         print(f"The staircase at 720x1280, 64 spp, {args.threads} threads: {full_ms / 1e3:,.2f} s (one render).")
 
