@@ -124,9 +124,11 @@ def git_commit():
         return "unknown"
 
 
-def lumiere_build(binary):
-    """Which lumiere a table is of: the work tree's commit for the tree's own build; for another
-    binary its path, since a binary cannot say which commit it was built from."""
+def lumiere_build(binary, commit=None):
+    """Which lumiere a table is of: the commit the binary's statistics name; for a binary too old
+    to name it, the work tree's commit for the tree's own build, else the binary's path."""
+    if commit:
+        return f"`{commit}` (the binary's)"
     if os.path.realpath(binary) == os.path.realpath(os.path.join(REPO, "target", "release", "lumiere")):
         return f"`{git_commit()}`"
     return f"the binary `{binary}` (not this work tree's build, which is at `{git_commit()}`)"
@@ -190,6 +192,7 @@ class Runner:
         self.tmp = tmp
         self.scenes = {}
         self.isa = None  # lumiere's, from its statistics
+        self.commit = None  # the binary's, from its statistics
         self.other = {"lumiere": 0.0, "Embree": 0.0}
 
     def scene_path(self, scene):
@@ -233,6 +236,7 @@ class Runner:
         with open(stats) as f:
             s = json.load(f)
         self.isa = s.get("isa", self.isa)
+        self.commit = s.get("commit", self.commit)
         return float(s["render_ms"]), int(s["rays"]), s
 
     def embree(self, row, threads, mode=None, image=None):
@@ -426,7 +430,7 @@ def main():
         + (f" under {hyper}" if hyper else "")
         + f", {', '.join(f for f in ('avx512f', 'avx2', 'fma') if f in flags) or 'no AVX'}; "
         f"load average {load_before[0]:.2f} before, {load_after[0]:.2f} after (1-minute); "
-        f"lumiere at {lumiere_build(args.lumiere)}, ISA `{runner.isa or 'unknown (no isa in its statistics)'}`; {embree_version()}, `embree_native --packet 1 --cull 1` "
+        f"lumiere at {lumiere_build(args.lumiere, runner.commit)}, ISA `{runner.isa or 'unknown (no isa in its statistics)'}`; {embree_version()}, `embree_native --packet 1 --cull 1` "
         f"(rtcIntersect1 camera rays, rtcOccluded8 shadow/AO rays; `--cull 1`: no shadow ray whose light point "
         f"cannot contribute, as in lumiere, so both trace the same rays)."
     )

@@ -379,7 +379,6 @@ def main() -> int:
     command = shlex.join(["python3", *sys.argv])
     started = datetime.datetime.now().astimezone()
     load = os.getloadavg()[0]
-    commit = lumiere_commit(args.lumiere)
 
     # --- Scene --------------------------------------------------------------------------------
     log(f"scene: {CORNELL / 'cornell.obj'} split by material into {out}")
@@ -392,7 +391,9 @@ def main() -> int:
     orbiter = ["--orbiter", str(orbiter_file)]
     log(f"camera: orbiter {orbiter_file.name} = look-at eye {vec(eye)} target {vec(target)} up {vec(up)}, fov 45")
     checks = []
-    a, *_ = run_lumiere(args, orbiter, out / "materials-orbiter.exr", ["--mode", "materials", "--spp", "1"])
+    a, first_stats, *_ = run_lumiere(args, orbiter, out / "materials-orbiter.exr", ["--mode", "materials", "--spp", "1"])
+    # The binary's own commit, from its statistics (binaries before it was there: the work tree's).
+    commit = first_stats.get("commit") or lumiere_commit(args.lumiere)
     b, *_ = run_lumiere(args, look_at, out / "materials-lookat.exr", ["--mode", "materials", "--spp", "1"])
     differ = float(np.mean(np.any(np.abs(a - b) > 1e-6, axis=-1)))
     checks.append(f"lumiere --mode materials, --orbiter vs the look-at: {differ:.4%} of pixels differ")

@@ -47,7 +47,7 @@ def fail(message):
 
 
 def render(lumiere, scene_args, size, spp, threads, workdir):
-    """Renders once; returns (render_ms, rays) from the stats JSON."""
+    """Renders once; returns (render_ms, rays, the binary's commit or None) from the stats JSON."""
     stats = os.path.join(workdir, "stats.json")
     command = [lumiere, "render", *scene_args, "--mode", "path", "--spp", str(spp), "--size", size,
                "--threads", str(threads), "--stats-json", stats, "-o", os.path.join(workdir, "image.png")]
@@ -56,7 +56,7 @@ def render(lumiere, scene_args, size, spp, threads, workdir):
         fail(f"{' '.join(command)} exited with {done.returncode}: {done.stderr.strip()}")
     with open(stats) as f:
         data = json.load(f)
-    return data["render_ms"], data["rays"]
+    return data["render_ms"], data["rays"], data.get("commit")
 
 
 def main():
@@ -85,17 +85,17 @@ def main():
         for repeat in range(args.repeats):
             for name, scene_args, size in scenes:
                 progress(f"repeat {repeat + 1}/{args.repeats}: {name}")
-                ms, count = render(args.lumiere, scene_args, size, args.spp, args.threads, workdir)
+                ms, count, commit = render(args.lumiere, scene_args, size, args.spp, args.threads, workdir)
                 times[name].append(ms)
                 rays[name] = count
         full_ms = None
         if args.full:
             progress("staircase at 720x1280, 64 spp")
-            full_ms, _ = render(args.lumiere, scenes[1][1], "720x1280", 64, args.threads, workdir)
+            full_ms, _, _ = render(args.lumiere, scenes[1][1], "720x1280", 64, args.threads, workdir)
     load_after = os.getloadavg()[0]
 
     print(f"`{shlex.join(['python3', *sys.argv])}` on **{started:%Y-%m-%d %H:%M} UTC**, "
-          f"lumiere at {lumiere_build(args.lumiere)}; load average {load_before:.2f} before, {load_after:.2f} after; "
+          f"lumiere at {lumiere_build(args.lumiere, commit)}; load average {load_before:.2f} before, {load_after:.2f} after; "
           f"medians of {args.repeats}, {args.threads} threads, `--mode path --spp {args.spp}`:")
     print()
     print("| scene | size | render ms (median) | runs (ms) | rays | ns per ray |")

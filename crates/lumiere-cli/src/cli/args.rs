@@ -8,7 +8,7 @@ use lumiere::render::aov::Aov;
 use lumiere::util::threads::MAX_THREADS;
 
 #[derive(Parser, Debug)]
-#[command(name = "lumiere", version, about = "A CPU Monte Carlo ray tracer", propagate_version = true)]
+#[command(name = "lumiere", version = concat!(env!("CARGO_PKG_VERSION"), " (", env!("LUMIERE_COMMIT"), ")"), about = "A CPU Monte Carlo ray tracer", propagate_version = true)]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,

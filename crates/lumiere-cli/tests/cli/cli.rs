@@ -180,6 +180,14 @@ fn stats_json_has_the_promised_fields() {
     assert_eq!(json["triangles"], 32);
     assert_eq!(json["rays"], 32 * 24);
     assert!(stderr(&run).contains("Mrays/s"), "closing line: {}", stderr(&run));
+    // The commit the binary was built from, as --version says it (benchmarks name what they ran).
+    let commit = json["commit"].as_str().expect("a commit");
+    assert!(!commit.is_empty());
+    let version = lumiere(&["--version"]);
+    assert_eq!(
+        String::from_utf8_lossy(&version.stdout).trim(),
+        format!("lumiere {} ({commit})", env!("CARGO_PKG_VERSION"))
+    );
 }
 
 #[test]

@@ -87,6 +87,8 @@ pub fn stats_json(
         "lights": world.lights().lights().len(),
         "bvh_nodes": world.accel().node_count(),
         "isa": world.isa().name(),
+        // The binary's commit (see build.rs): a benchmark's table names what it ran.
+        "commit": env!("LUMIERE_COMMIT"),
         "load_ms": timings.load_ms,
         "build_ms": timings.build_ms,
         "render_ms": output.stats.elapsed.as_secs_f64() * 1e3,
