@@ -128,7 +128,13 @@ impl Fingerprints {
             Some(Mismatch::Scene)
         } else if checkpoint.options_fingerprint != hash_bytes(self.options.as_bytes()) || checkpoint.seed != self.seed
         {
-            Some(Mismatch::Options(differing_options(&checkpoint.options, &self.options)))
+            let mut differing = differing_options(&checkpoint.options, &self.options);
+            // The same text under another fingerprint or seed: the file's fields disagree with
+            // its own options (an altered file), which the refusal must still name.
+            if differing.is_empty() {
+                differing.push("its seed or options fingerprint, which disagree with its options text".to_string());
+            }
+            Some(Mismatch::Options(differing))
         } else if film != self.image {
             // Its options name the image size, but its film is written apart.
             Some(Mismatch::FilmSize { film, image: self.image })

@@ -165,3 +165,65 @@ fn a_pass_stopped_midway_leaves_the_film_as_it_was() {
         assert_eq!(stopped.image, expected.image());
     }
 }
+
+/// The noise estimate against its definition, written out plainly: the root mean square over
+/// pixels of the standard error of each pixel's mean luminance (the unbiased sample variance over
+/// n), divided by the image's mean luminance; none before two samples, 0 for a black image.
+#[test]
+fn the_relative_error_is_the_rms_standard_error_over_the_mean_luminance() {
+    let grey = |k: u32, values: [f32; 2]| PassSamples {
+        sample: k,
+        width: 2,
+        height: 1,
+        values: values.map(Vec3::splat).to_vec(),
+        rays: 0,
+    };
+    let passes = [[1.0, 2.0], [3.0, 2.0], [2.0, 5.0]];
+    let mut film = Film::new(2, 1).unwrap();
+    assert_eq!(film.relative_error(), None, "no sample");
+    for (k, values) in passes.iter().enumerate() {
+        film.add_pass(&grey(k as u32, *values)).unwrap();
+        let samples = &passes[..=k];
+        let n = samples.len() as f64;
+        if n < 2.0 {
+            assert_eq!(film.relative_error(), None, "one sample has no variance");
+            continue;
+        }
+        let (mut variance_sum, mut mean_sum) = (0.0, 0.0);
+        for pixel in 0..2 {
+            let mean = samples.iter().map(|s| f64::from(s[pixel])).sum::<f64>() / n;
+            let variance = samples.iter().map(|s| (f64::from(s[pixel]) - mean).powi(2)).sum::<f64>() / (n - 1.0);
+            variance_sum += variance / n;
+            mean_sum += mean;
+        }
+        let expected = (variance_sum / 2.0).sqrt() / (mean_sum / 2.0);
+        let error = film.relative_error().unwrap();
+        assert!((error - expected).abs() < 1e-6 * expected, "{} samples: {error} where {expected}", k + 1);
+    }
+    // By hand, for the first two: pixel 0 (1, 3) has variance of the mean 1, pixel 1 (2, 2) none.
+    let mut two = Film::new(2, 1).unwrap();
+    two.add_pass(&grey(0, passes[0])).unwrap();
+    two.add_pass(&grey(1, passes[1])).unwrap();
+    assert!((two.relative_error().unwrap() - 0.5f64.sqrt() / 2.0).abs() < 1e-6);
+    let mut black = Film::new(2, 1).unwrap();
+    black.add_pass(&grey(0, [0.0; 2])).unwrap();
+    black.add_pass(&grey(1, [0.0; 2])).unwrap();
+    assert_eq!(black.relative_error(), Some(0.0), "a black image has no relative error, not NaN");
+}
+
+/// A pass must match the film in its size and its number of values, both: a transposed pass (the
+/// same count of values) or one short of a value is refused, and the film is left as it was.
+#[test]
+fn a_pass_of_another_shape_or_length_is_refused() {
+    let mut film = Film::new(WIDTH, HEIGHT).unwrap();
+    film.add_pass(&pass(0)).unwrap();
+    let before = film.clone();
+    let transposed = PassSamples { width: HEIGHT, height: WIDTH, ..pass(1) };
+    let short = PassSamples { values: pass(1).values[1..].to_vec(), ..pass(1) };
+    for bad in [transposed, short] {
+        let error = film.add_pass(&bad).unwrap_err().to_string();
+        assert!(error.contains("but the film is 5x3"), "{error}");
+        assert_eq!(film, before);
+    }
+    film.add_pass(&pass(1)).unwrap();
+}

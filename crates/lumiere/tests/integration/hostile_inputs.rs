@@ -537,3 +537,17 @@ fn an_mtl_given_as_the_scene_says_what_to_give() {
         )
     );
 }
+
+/// The inflation cap is the most bytes a stream may give: exactly that many are accepted, over
+/// several members too, and one more is refused.
+#[test]
+fn gzip_inflating_to_exactly_its_cap_is_accepted() {
+    let text = b"v 0 0 0\nv 1 0 0\n";
+    let member = gzip(text);
+    let cap = text.len() as u64;
+    assert_eq!(gunzip(&member, cap).unwrap(), text);
+    assert_eq!(gunzip(&[&member[..], &member[..]].concat(), 2 * cap).unwrap(), [&text[..], &text[..]].concat());
+    let error = gunzip(&member, cap - 1).unwrap_err();
+    assert_eq!(error.kind(), io::ErrorKind::OutOfMemory, "{error}");
+    assert!(gunzip(&[&member[..], &member[..]].concat(), 2 * cap - 1).is_err());
+}

@@ -2,9 +2,11 @@
 
 mod common;
 
+mod aovs;
 mod bsdfs;
 mod bvh;
 mod camera;
+mod checkpoint;
 mod cutouts;
 mod estimators;
 mod film;

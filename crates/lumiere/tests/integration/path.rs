@@ -193,3 +193,44 @@ fn sobol_halves_the_path_tracers_variance_on_the_cornell_box() {
     );
     assert!(sobol < 0.75 * independent, "Sobol {sobol:.3e} vs independent {independent:.3e}");
 }
+
+/// A clear glass pane (index 1.5) in front of a large emitter of radiance 1, seen at 60° from its
+/// normal: a ray enters at 60° and leaves at 60° (35° inside, below the critical angle of 42°), and
+/// each face lets through 1 − F(60°) ≈ 91% of it, about 0.84 in all with the reflections inside.
+/// It fails if the path tracer takes the pane's front face for its back (total internal
+/// reflection at 60°, and the emitter unseen).
+#[test]
+fn light_through_a_glass_pane_at_sixty_degrees() {
+    let quad = |z: f32, half: f32, facing: f32| {
+        let corners = [
+            Vec3::new(-half, -half, z),
+            Vec3::new(half, -half, z),
+            Vec3::new(half, half, z),
+            Vec3::new(-half, half, z),
+        ];
+        let triangles = if facing > 0.0 { [[0, 1, 2], [0, 2, 3]] } else { [[0, 2, 1], [0, 3, 2]] };
+        (corners, triangles)
+    };
+    let mut mesh = TriangleMesh::default();
+    // The pane's faces, their normals outwards (+z in front, -z behind), and the emitter facing it.
+    for (material, (corners, triangles)) in
+        [(0, quad(0.0, 20.0, 1.0)), (0, quad(-0.2, 20.0, -1.0)), (1, quad(-5.0, 60.0, 1.0))]
+    {
+        let first = mesh.positions.len() as u32;
+        mesh.positions.extend(corners);
+        for t in triangles {
+            mesh.indices.push(t.map(|i| first + i));
+            mesh.material_ids.push(material);
+        }
+    }
+    let glass = Material { illum: 7, ni: 1.5, tf: Vec3::ONE, kd: Vec3::ZERO, ..Material::default_grey("glass") };
+    let light = Material { kd: Vec3::ZERO, ke: Vec3::ONE, ..Material::default_grey("light") };
+    let world =
+        World::new(Scene::from_parts("pane".into(), mesh, vec![glass, light], vec![]).unwrap(), BuildPreset::Default);
+    let eye = Vec3::new(0.0, 3.0 * 60f32.to_radians().sin(), 3.0 * 60f32.to_radians().cos());
+    let camera = Camera::look_at(eye, Vec3::ZERO, Vec3::Y, 2.0, 4, 4).unwrap();
+    for strategy in [PathStrategy::Mis, PathStrategy::BsdfOnly] {
+        let mean = image_mean(&world, &camera, path(8, strategy), 256, 1);
+        assert!((0.74..0.94).contains(&mean), "{strategy:?}: {mean}");
+    }
+}

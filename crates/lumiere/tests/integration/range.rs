@@ -3,7 +3,7 @@
 
 use std::sync::atomic::AtomicBool;
 
-use lumiere::integrators::{Path, Technique};
+use lumiere::integrators::{AmbientOcclusion, Hits, Path, Technique};
 use lumiere::render::film::{Film, PassSamples};
 use lumiere::render::{RenderOptions, render, render_pass_range};
 use lumiere::scene::camera::Camera;
@@ -91,4 +91,68 @@ fn an_image_of_more_pixels_than_32_bits_number_is_refused() {
     let cancel = AtomicBool::new(true);
     let error = render_pass_range(&world, &camera, &options, 0, 1, &|_| {}, &cancel).unwrap_err().to_string();
     assert!(error.contains("more than 4,294,967,295 pixels"), "{error}");
+}
+
+/// Options are checked before any pass: a range of no passes renders nothing, so it says whether
+/// options are accepted without rendering (nor allocating) an image.
+fn accepts((world, camera): (World, Camera), options: &RenderOptions) -> Result<(), String> {
+    let cancel = AtomicBool::new(false);
+    render_pass_range(&world, &camera, options, 0, 0, &|_| {}, &cancel)
+        .map(|passes| assert!(passes.is_empty()))
+        .map_err(|e| e.to_string())
+}
+
+/// The most pixels a render numbers is 2^32 - 1 (65,535 x 65,537) exactly; an image without
+/// pixels in either direction is refused.
+#[test]
+fn image_sizes_are_refused_at_the_bounds_exactly() {
+    let options = RenderOptions::new(Technique::Path(Path::default()));
+    assert_eq!(accepts(cornell(65_535, 65_537), &options), Ok(()));
+    let error = accepts(cornell(65_536, 65_536), &options).unwrap_err();
+    assert!(error.contains("more than 4,294,967,295 pixels"), "{error}");
+    for (width, height) in [(0, 4), (4, 0)] {
+        let error = accepts(cornell(width, height), &options).unwrap_err();
+        assert!(error.contains("has no pixels"), "{width}x{height}: {error}");
+    }
+}
+
+#[test]
+fn a_noise_target_must_be_positive() {
+    let with = |target: f64| RenderOptions {
+        noise_target: Some(target),
+        ..RenderOptions::new(Technique::Path(Path::default()))
+    };
+    assert_eq!(accepts(cornell(8, 6), &with(0.01)), Ok(()));
+    for target in [0.0, -0.5, f64::NAN] {
+        let error = accepts(cornell(8, 6), &with(target)).unwrap_err();
+        assert!(error.contains("the noise target must be positive"), "{target}: {error}");
+    }
+}
+
+/// Technique settings no render can use are refused: no samples, or an occlusion distance that is
+/// not positive (NaN included).
+#[test]
+fn technique_settings_no_render_can_use_are_refused() {
+    let ao = |samples, distance| Technique::AmbientOcclusion(AmbientOcclusion { samples, distance });
+    for technique in [ao(4, 0.5), ao(1, f32::INFINITY), Technique::direct(1)] {
+        assert!(technique.validate().is_ok(), "{technique:?}");
+    }
+    for distance in [0.0, -1.0, f32::NAN, f32::NEG_INFINITY] {
+        let error = ao(4, distance).validate().unwrap_err().to_string();
+        assert!(error.contains("distance must be positive"), "{distance}: {error}");
+    }
+    for technique in [ao(0, 1.0), Technique::direct(0)] {
+        let error = technique.validate().unwrap_err().to_string();
+        assert!(error.contains("must be at least 1"), "{technique:?}: {error}");
+    }
+}
+
+/// A pass counts every ray its tiles traced: one camera ray a pixel for hits, over an image of
+/// several bands and tile columns (and a partial tile at each far edge).
+#[test]
+fn a_pass_counts_every_ray_of_its_tiles() {
+    let (world, camera) = cornell(150, 70);
+    let options = RenderOptions { spp: 2, ..RenderOptions::new(Technique::Hits(Hits)) };
+    let passes = render_pass_range(&world, &camera, &options, 0, 2, &|_| {}, &AtomicBool::new(false)).unwrap();
+    assert!(passes.iter().all(|pass| pass.rays == 150 * 70), "{:?}", passes.iter().map(|p| p.rays).collect::<Vec<_>>());
 }
