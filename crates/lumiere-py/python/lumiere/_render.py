@@ -43,6 +43,13 @@ def _array(buffer: bytearray, height: int, width: int) -> np.ndarray:
     return np.frombuffer(buffer, dtype=np.float32).reshape(height, width, 3)
 
 
+def _check_progress(progress: Optional[Progress]) -> None:
+    """Refuses, before any work, a progress callback that cannot be called (found out otherwise
+    only once passes have been rendered)."""
+    if progress is not None and not callable(progress):
+        raise TypeError(f"progress must be callable as progress(done, total), got {type(progress).__name__}")
+
+
 def _options(
     mode: str,
     spp: Optional[int],
@@ -119,9 +126,7 @@ def render_full(
         aovs = (aovs,)
     if aovs is None:
         aovs = ()
-    # Checked now, not after the render's first pass: a callback that cannot be called.
-    if progress is not None and not callable(progress):
-        raise TypeError(f"progress must be callable as progress(done, total), got {type(progress).__name__}")
+    _check_progress(progress)
     try:
         aovs = tuple(_text(aov, f"aovs[{index}]") for index, aov in enumerate(aovs))
     except TypeError:

@@ -26,7 +26,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 import numpy as np
 
 from .. import _lumiere
-from .._render import Progress, RenderResult, _array, _camera, _options
+from .._render import Progress, RenderResult, _array, _camera, _check_progress, _options
 from .._scene import Camera, Scene, _integer, _path, _rebuild_camera, _rebuild_scene
 from ..errors import LumiereError
 
@@ -244,8 +244,7 @@ def render_full(
             and (not isinstance(checkpoint_every, int) or abs(checkpoint_every) < 2**1023)
             and math.isfinite(checkpoint_every) and checkpoint_every >= 0):
         raise LumiereError(f"checkpoint_every must be a finite number of seconds, at least 0, got {checkpoint_every!r}")
-    if progress is not None and not callable(progress):
-        raise TypeError(f"progress must be callable as progress(done, total), got {type(progress).__name__}")
+    _check_progress(progress)
     if resume and checkpoint is None:
         raise LumiereError("resume needs the checkpoint to resume from")
     # Refused now, not once the render is done and the checkpoint cannot hold it.
