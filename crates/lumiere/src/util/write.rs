@@ -265,3 +265,26 @@ fn fill_and_rename(mut file: File, temp: &Path, path: &Path, bytes: &[u8]) -> st
     drop(file);
     fs::rename(temp, path)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A temporary file left registered after its rename would be removed by a later
+    /// [`remove_in_flight`], by then perhaps another process's file of the same name (a pid reused
+    /// in a container sharing the folder).
+    #[test]
+    fn a_finished_write_leaves_no_temporary_registered() {
+        let dir = std::env::temp_dir().join(format!("lumiere-write-{}", std::process::id()));
+        fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("image.png");
+        write_atomically(&path, b"bytes").unwrap();
+        assert_eq!(fs::read(&path).unwrap(), b"bytes");
+        // Other tests of this process may be writing elsewhere: only this folder's entries count.
+        let in_flight = IN_FLIGHT.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+        let ours: Vec<_> = in_flight.iter().filter(|temp| temp.starts_with(&dir)).collect();
+        assert!(ours.is_empty(), "still registered after the write: {ours:?}");
+        drop(in_flight);
+        fs::remove_dir_all(&dir).unwrap();
+    }
+}
