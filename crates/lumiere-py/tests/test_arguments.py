@@ -33,6 +33,12 @@ def from_arrays(**kwargs):
     [
         (lambda: look_at(fov=HUGE), "fov must be at most"),
         (lambda: look_at(eye=(HUGE, 0, 1)), "eye must fit in float32"),
+        # Finite floats beyond float32's range: named with their value, not as the infinity they
+        # would become.
+        (lambda: look_at(fov=1e300), r"fov must fit in float32 .*got 1e\+300"),
+        (lambda: lumiere.Camera.framing(lumiere.builtin(), fov=1e300), r"fov must fit in float32 .*got 1e\+300"),
+        (lambda: write_image(exposure=-1e39), r"exposure must fit in float32 .*got -1e\+39"),
+        (lambda: render(mode="ao", ao_distance=1e39), r"ao_distance must fit in float32 .*got 1e\+39"),
         (lambda: render(spp=None, time=HUGE), "time must be at most"),
         (lambda: render(spp=None, noise=HUGE), "noise must be at most"),
         (lambda: render(mode="ao", ao_distance=HUGE), "ao_distance must be at most"),

@@ -59,8 +59,8 @@ def write_image(path: str, image: "object", exposure: float = 0.0, tonemap: str 
     # A side the writers' u32 cannot hold (an empty array can have one) is an error, not an overflow.
     if max(width, height) > 2**32 - 1:
         raise LumiereError(f"image size {width}x{height} is too large: at most 4294967295 pixels a side")
-    _write_image(_path(path), width, height, array.tobytes(), _number(exposure, "exposure"), _text(tonemap, "tonemap"))
+    _write_image(_path(path), width, height, array.tobytes(), _float32(exposure, "exposure"), _text(tonemap, "tonemap"))
 
 
 from ._lumiere import write_image as _write_image  # noqa: E402
-from ._scene import _number, _path, _text  # noqa: E402
+from ._scene import _float32, _path, _text  # noqa: E402

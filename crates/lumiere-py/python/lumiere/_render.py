@@ -9,7 +9,7 @@ from typing import Any, Callable, Dict, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from . import _lumiere
-from ._scene import DEFAULT_SIZE, Camera, Scene, _first_repeat, _integer, _number, _stacklevel_outside, _text
+from ._scene import DEFAULT_SIZE, Camera, Scene, _first_repeat, _float32, _integer, _number, _stacklevel_outside, _text
 from .errors import LumiereError
 
 __all__ = ["render", "render_full", "RenderResult", "MODES", "AOVS", "TECHNIQUE_OPTIONS"]
@@ -74,7 +74,7 @@ def _options(
         if technique_options.get(name) is not None:
             technique_options[name] = _integer(technique_options[name], name, low, 2**32 - 1)
     if technique_options.get("ao_distance") is not None:
-        technique_options["ao_distance"] = _number(technique_options["ao_distance"], "ao_distance")
+        technique_options["ao_distance"] = _float32(technique_options["ao_distance"], "ao_distance")
     if technique_options.get("light_sampling") is not None:
         technique_options["light_sampling"] = _text(technique_options["light_sampling"], "light_sampling")
     mode = _text(mode, "mode")

@@ -47,11 +47,24 @@ def _vector(value: Any, what: str) -> Tuple[float, float, float]:
     except OverflowError:
         # An integer beyond float64's range: beyond float32's too (its digits are not worth printing).
         raise LumiereError(f"{what} must fit in float32 (at most {_F32_MAX:.7g} in magnitude)") from None
-    # The native side stores float32: a finite number beyond its range would arrive as infinity
-    # and be refused under another name (infinity and NaN are left to its own checks).
-    if any(math.isfinite(v) and abs(v) > _F32_MAX for v in (x, y, z)):
+    if any(not _fits_float32(v) for v in (x, y, z)):
         raise LumiereError(f"{what} must fit in float32 (at most {_F32_MAX:.7g} in magnitude), got {value!r}")
     return (x, y, z)
+
+
+def _fits_float32(value: float) -> bool:
+    """Whether ``value`` reaches the native side, which stores float32, as itself: a finite number
+    beyond its range would arrive as infinity and be refused under another value (infinity and NaN
+    are left to the native side's own checks)."""
+    return not (math.isfinite(value) and abs(value) > _F32_MAX)
+
+
+def _float32(value: Any, what: str) -> float:
+    """:func:`_number` for a number the native side takes as float32."""
+    number = _number(value, what)
+    if not _fits_float32(number):
+        raise LumiereError(f"{what} must fit in float32 (at most {_F32_MAX:.7g} in magnitude), got {value!r}")
+    return number
 
 
 def _number(value: Any, what: str) -> float:
@@ -371,7 +384,7 @@ class Camera:
     ) -> "Camera":
         """A pinhole at ``eye`` looking at ``target``, ``fov`` the vertical field of view in degrees
         (``--eye/--target/--up/--fov`` of the CLI)."""
-        args = (_vector(eye, "eye"), _vector(target, "target"), _vector(up, "up"), _number(fov, "fov"), *_size(size))
+        args = (_vector(eye, "eye"), _vector(target, "target"), _vector(up, "up"), _float32(fov, "fov"), *_size(size))
         return cls(_lumiere.NativeCamera.look_at(*args), ("look_at", args))
 
     @classmethod
@@ -397,7 +410,7 @@ class Camera:
         given without one."""
         if not isinstance(scene, Scene):
             raise TypeError(f"scene must be a lumiere.Scene, got {type(scene).__name__}")
-        eye, target = _lumiere.NativeCamera.framing(scene._native, _number(fov, "fov"))
+        eye, target = _lumiere.NativeCamera.framing(scene._native, _float32(fov, "fov"))
         return cls.look_at(eye, target, up, fov, size)
 
     @property
