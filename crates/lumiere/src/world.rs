@@ -7,6 +7,7 @@ use glam::{Vec2, Vec3};
 
 use crate::accel::simd::lanes_of;
 use crate::accel::{Accel, BuildPreset, Hit, Isa, OriginBatch, Region};
+use crate::error::shown_name;
 use crate::geometry::surface::SurfacePoint;
 use crate::geometry::surface_lanes::{HitCorners, SurfaceRows};
 use crate::lights::LightSet;
@@ -93,7 +94,10 @@ impl World {
         // that find it too: cut out, a BSDF-sampled ray would pass where light sampling adds
         // emission, and the two strategies would disagree.
         for emitter in scene.materials.iter().filter(|m| m.is_emissive() && m.map_d.is_some()) {
-            warnings.push(format!("material '{}': map_d is ignored on an emitter; it stays opaque", emitter.name));
+            warnings.push(format!(
+                "material {}: map_d is ignored on an emitter; it stays opaque",
+                shown_name(&emitter.name)
+            ));
         }
         let (cutout_of_material, cutouts, cutout_warnings) =
             TextureSet::for_cutouts(scene.materials.iter().map(|m| m.map_d.as_deref().filter(|_| !m.is_emissive())));

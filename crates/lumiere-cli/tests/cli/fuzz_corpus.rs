@@ -433,16 +433,16 @@ fn odd_mtl_gives_warnings_not_errors() {
 #[test]
 fn orbiter_files_with_missing_lines_huge_numbers_or_nan_are_refused() {
     let cases = [
-        ("missing-s.txt", 4, "missing 's' line"),
-        ("missing-c.txt", 4, "missing 'c' line"),
+        ("missing-s.txt", 3, "missing 's' line"),
+        ("missing-c.txt", 3, "missing 'c' line"),
         ("empty.txt", 1, "missing 'c' line"),
         ("truncated-mid-line.txt", 4, "'s' expects 2 numbers, found 1"),
-        ("truncated-mid-exponent.txt", 4, "'s' expects finite numbers, found '3.4e'"),
-        ("nan.txt", 1, "'c' expects finite numbers, found 'nan'"),
-        ("inf.txt", 2, "'p' expects finite numbers, found 'inf'"),
-        ("overflow-1e400.txt", 4, "'s' expects finite numbers, found '1e400'"),
+        ("truncated-mid-exponent.txt", 4, "'s' expects finite numbers, found \"3.4e\""),
+        ("nan.txt", 1, "'c' expects finite numbers, found \"nan\""),
+        ("inf.txt", 2, "'p' expects finite numbers, found \"inf\""),
+        ("overflow-1e400.txt", 4, "'s' expects finite numbers, found \"1e400\""),
         ("extra-number.txt", 1, "'c' expects 3 numbers, found 4"),
-        ("unknown-field.txt", 5, "unknown orbiter field 'zoom'"),
+        ("unknown-field.txt", 5, "unknown orbiter field \"zoom\""),
         ("not-utf8.txt", 5, "not UTF-8"),
         ("zero-radius.txt", 4, "'s' gives a radius of 0.0 at a distance of 2.78"),
         ("tiny-radius.txt", 4, "'s' gives a radius of 1e-320 at a distance of 1.27"),

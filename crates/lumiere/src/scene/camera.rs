@@ -9,7 +9,7 @@ use std::path::Path;
 
 use glam::{DMat4, DVec2, DVec3, DVec4, Vec3};
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, quote};
 use crate::math::{Aabb, Ray};
 
 /// gKit's `Orbiter` state as stored in its text files (`c`, `p`, `r`, `s`, optional `f` lines).
@@ -51,14 +51,14 @@ impl Orbiter {
                     return Err(Error::parse(
                         path,
                         line,
-                        format!("unknown orbiter field '{key}' (expected c, p, r, s or f)"),
+                        format!("unknown orbiter field {} (expected c, p, r, s or f)", quote(key)),
                     ));
                 }
             };
             let values = tokens
                 .map(|t| t.parse::<f64>().ok().filter(|v| v.is_finite()).ok_or(t))
                 .collect::<std::result::Result<Vec<f64>, &str>>()
-                .map_err(|t| Error::parse(path, line, format!("'{key}' expects finite numbers, found '{t}'")))?;
+                .map_err(|t| Error::parse(path, line, format!("'{key}' expects finite numbers, found {}", quote(t))))?;
             if values.len() != arity {
                 return Err(Error::parse(
                     path,
@@ -71,9 +71,11 @@ impl Orbiter {
                 size_line = line;
             }
         }
-        let total_lines = bytes.split(|&b| b == b'\n').count();
+        // A missing line is reported at the end of the file: its last line, as an editor counts
+        // them (a final newline does not start another), or line 1 of an empty file.
+        let last_line = bytes.strip_suffix(b"\n").unwrap_or(bytes).split(|&b| b == b'\n').count();
         let mut take = |slot: usize, key: &str| {
-            fields[slot].take().ok_or_else(|| Error::parse(path, total_lines, format!("missing '{key}' line")))
+            fields[slot].take().ok_or_else(|| Error::parse(path, last_line, format!("missing '{key}' line")))
         };
         let (c, p, r, s) = (take(0, "c")?, take(1, "p")?, take(2, "r")?, take(3, "s")?);
         let frame = fields[4].take().map(|f| (f[0], f[1], f[2]));

@@ -47,6 +47,18 @@ fn orbiter_parse_reads_all_fields_and_rejects_garbage() {
     assert!(err.contains("missing 's'"), "{err}");
     let err = Orbiter::parse(b"c 0 0 nan\n", path).unwrap_err().to_string();
     assert!(err.contains("cam.txt:1"), "{err}");
+    // Tokens from the file are quoted escaped and cut: a terminal's escape sequence cannot act, and
+    // a five-megabyte number does not make a five-megabyte message.
+    let err = Orbiter::parse(b"c 0 0 0\n\x1b[31mzoom 1\n", path).unwrap_err().to_string();
+    assert_eq!(err, "cam.txt:2: unknown orbiter field \"\\u{1b}[31mzoom\" (expected c, p, r, s or f)");
+    let huge = format!("c 0 0 {}x\n", "9".repeat(5_000_000));
+    let err = Orbiter::parse(huge.as_bytes(), path).unwrap_err().to_string();
+    assert!(err.starts_with("cam.txt:1: 'c' expects finite numbers, found \"999") && err.len() < 200, "{err:.300}");
+    // A missing line is reported at the file's last line, whether or not a newline ends it.
+    for text in [&b"c 0 0 0\np 0 0\nr 0 0\n"[..], b"c 0 0 0\np 0 0\nr 0 0"] {
+        let err = Orbiter::parse(text, path).unwrap_err().to_string();
+        assert_eq!(err, "cam.txt:3: missing 's' line");
+    }
 }
 
 #[test]

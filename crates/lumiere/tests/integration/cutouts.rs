@@ -137,6 +137,11 @@ fn an_emitter_ignores_its_mask_with_a_warning() {
     for isa in Isa::supported() {
         let world = World::with_isa(masked.clone(), BuildPreset::Default, isa);
         assert_eq!(world.warnings(), ["material 'light': map_d is ignored on an emitter; it stays opaque"]);
+        // A name with a terminal's escape sequence is quoted escaped, as in every other warning.
+        let mut escaped = masked.clone();
+        escaped.materials[1].name = "lamp\x1b[31mRED".into();
+        let warnings = World::with_isa(escaped, BuildPreset::Default, isa).warnings().to_vec();
+        assert_eq!(warnings, ["material \"lamp\\u{1b}[31mRED\": map_d is ignored on an emitter; it stays opaque"]);
         let got = images_of(&world);
         for (k, (g, e)) in got.iter().zip(&images(&plain, isa)).enumerate() {
             assert!(g == e, "{isa}: technique {:?} differs with a clear mask on the light", techniques()[k].0);
