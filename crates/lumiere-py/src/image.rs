@@ -5,6 +5,7 @@
 use std::path::PathBuf;
 
 use lumiere::image_io::{PngEncoding, PngStyle, Tonemap, check_output_path, encode_image};
+use lumiere::render::checkpoint::Checkpoint;
 use lumiere::util::write::{check_writable, write_atomically};
 use pyo3::prelude::*;
 
@@ -52,10 +53,12 @@ pub fn check_image_output(path: PathBuf, exposure: f32, tonemap: &str) -> PyResu
     check_output_path(&path).or_py()
 }
 
-/// Refuses, before a long render, a file (a checkpoint) that could not be written at `path`.
+/// Refuses, before a long render, a checkpoint that could not be written at `path`, or that
+/// would replace a file other than a checkpoint.
 #[pyfunction]
-pub fn check_writable_output(path: PathBuf) -> PyResult<()> {
-    check_writable(&path).or_py()
+pub fn check_checkpoint_output(path: PathBuf) -> PyResult<()> {
+    check_writable(&path).or_py()?;
+    Checkpoint::check_replaceable(&path).or_py()
 }
 
 /// The PNG style of `exposure` (the CLI's range) and `tonemap`, or the refusal.

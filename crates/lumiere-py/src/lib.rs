@@ -27,7 +27,7 @@ fn _lumiere(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_function(wrap_pyfunction!(film::render_passes, module)?)?;
     module.add_function(wrap_pyfunction!(image::write_image, module)?)?;
     module.add_function(wrap_pyfunction!(image::check_image_output, module)?)?;
-    module.add_function(wrap_pyfunction!(image::check_writable_output, module)?)?;
+    module.add_function(wrap_pyfunction!(image::check_checkpoint_output, module)?)?;
     module.add_function(wrap_pyfunction!(files::check_outputs, module)?)?;
     module.add_function(wrap_pyfunction!(files::read_input, module)?)?;
     Ok(())

@@ -277,6 +277,11 @@ def test_bad_arguments_are_refused_before_connecting(tmp_path):
     # A checkpoint that cannot be written is refused now, not after the render it would hold.
     with pytest.raises(lumiere.LumiereError, match="is a directory"):
         distributed.render(lumiere.builtin(), spp=2, checkpoint=tmp_path, address="127.0.0.1:9")
+    # A slip of the name must not replace a file that is not a checkpoint.
+    (tmp_path / "notes.txt").write_text("a user's notes")
+    with pytest.raises(lumiere.LumiereError, match="is not a lumiere checkpoint"):
+        distributed.render(lumiere.builtin(), spp=2, checkpoint=tmp_path / "notes.txt", address="127.0.0.1:9")
+    assert (tmp_path / "notes.txt").read_text() == "a user's notes"
     with pytest.raises(lumiere.LumiereError, match="tasks must be an integer of at least 1"):
         distributed.render(lumiere.builtin(), spp=2, tasks=0, address="127.0.0.1:9")
     with pytest.raises(lumiere.LumiereError, match="threads_per_task must be at most 1024"):

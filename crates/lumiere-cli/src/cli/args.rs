@@ -261,8 +261,8 @@ pub struct RenderArgs {
     #[arg(long)]
     pub denoise: bool,
 
-    /// Write render statistics (mode, size, rays, timings) as JSON to this file; `-` for stdout.
-    #[arg(long)]
+    /// Write render statistics (mode, size, rays, timings) as JSON to this .json file; `-` for stdout.
+    #[arg(long, value_parser = parse_stats_json_path)]
     pub stats_json: Option<PathBuf>,
 
     /// Stop after this much rendering time in this run, keeping the completed passes (e.g. 30s, 5m, 1h, 1.5s).
@@ -337,8 +337,9 @@ fn parse_positive_f32(s: &str) -> Result<f32, String> {
     if value.is_finite() && value > 0.0 { Ok(value) } else { Err(format!("out of range, got {s:?}")) }
 }
 
-/// A benchmark's JSON output: a `.json` file, so that a slip (`--json scene.obj`) cannot replace an
-/// input or another file with the table, and a folder is refused before the benchmark runs.
+/// A JSON output: a `.json` file, so that a slip (`--json scene.obj`, `--stats-json notes.txt`)
+/// cannot replace an input or another file with the table, and a folder is refused before the
+/// work runs.
 fn parse_json_path(s: &str) -> Result<PathBuf, String> {
     let path = PathBuf::from(s);
     if path.is_dir() {
@@ -348,6 +349,14 @@ fn parse_json_path(s: &str) -> Result<PathBuf, String> {
         Some(extension) if extension.eq_ignore_ascii_case("json") => Ok(path),
         _ => Err(format!("expected a .json file name, got {s:?}")),
     }
+}
+
+/// `--stats-json -` writes the statistics to stdout.
+pub const STDOUT_ARG: &str = "-";
+
+/// The render statistics' output: a `.json` file, as for a benchmark's, or `-` for stdout.
+fn parse_stats_json_path(s: &str) -> Result<PathBuf, String> {
+    if s == STDOUT_ARG { Ok(PathBuf::from(s)) } else { parse_json_path(s) }
 }
 
 /// Timed repetitions of a benchmark: at least one, and few enough that their times fit in memory.

@@ -224,7 +224,12 @@ fn outputs_that_are_inputs_or_each_other_are_refused() {
     let scene = scene.to_str().unwrap();
     let out = dir.arg("out.png");
     let small = ["render", "--size", "8x6"];
-    assert_refused(&dir, &[&small[..], &["-o", &out, "--stats-json", &out]].concat(), "are the same file");
+    let json = dir.arg("out.json");
+    assert_refused(
+        &dir,
+        &[&small[..], &["-o", &out, "--stats-json", &json, "--checkpoint", &json]].concat(),
+        "are the same file",
+    );
     assert_refused(
         &dir,
         &[&small[..], &[scene, "-o", &out, "--checkpoint", scene]].concat(),
@@ -232,12 +237,34 @@ fn outputs_that_are_inputs_or_each_other_are_refused() {
     );
     // The same file under another name (a relative path with `..`) is caught by device and inode.
     let other_name = format!("{}/../{}/scene.obj", dir.0.display(), dir.0.file_name().unwrap().to_string_lossy());
-    assert_refused(&dir, &[&small[..], &[scene, "-o", &out, "--stats-json", &other_name]].concat(), "same file");
+    assert_refused(&dir, &[&small[..], &[scene, "-o", &out, "--checkpoint", &other_name]].concat(), "same file");
     // As root, a rename over a device node would replace it with a regular file.
     assert_refused(&dir, &[&small[..], &["-o", &out, "--checkpoint", "/dev/null"]].concat(), "not a regular file");
     // Here stdout is a pipe: the link /dev/stdout leads to nothing a file can replace.
     assert_refused(&dir, &[&small[..], &["-o", &out, "--checkpoint", "/dev/stdout"]].concat(), "is a link to nothing");
     assert_refused(&dir, &[&small[..], &["-o", &dir.arg("out")]].concat(), "has no extension");
+}
+
+/// A slip of the name (`--stats-json notes.txt`, `--checkpoint notes.txt`) must not replace a file
+/// that is no input of the render: the statistics go only to a .json file, and a checkpoint
+/// replaces only a checkpoint (or an empty file).
+#[test]
+fn the_statistics_and_the_checkpoint_replace_only_their_own_kind_of_file() {
+    let dir = TempDir::new("own-kind");
+    dir.write("notes.txt", "a user's notes");
+    let (notes, out) = (dir.arg("notes.txt"), dir.arg("out.png"));
+    let small = ["render", "--size", "8x6", "--mode", "hits", "-o", &out];
+    assert_refused(&dir, &[&small[..], &["--stats-json", &notes]].concat(), "expected a .json file name");
+    assert_refused(&dir, &[&small[..], &["--checkpoint", &notes]].concat(), "is not a lumiere checkpoint");
+    // A checkpoint is replaced by the next one, and an empty file (nothing to lose) is taken.
+    dir.write("empty.ckpt", "");
+    let checkpoint = dir.arg("empty.ckpt");
+    for _ in 0..2 {
+        let run = run(&[&small[..], &["--checkpoint", &checkpoint, "--stats-json", &dir.arg("s.json")]].concat());
+        assert_eq!(run.status.code(), Some(0), "{}", stderr(&run));
+    }
+    assert!(fs::read(dir.path("empty.ckpt")).unwrap().starts_with(b"LUMCKPT"));
+    assert_eq!(fs::read(dir.path("notes.txt")).unwrap(), b"a user's notes");
 }
 
 /// The files a scene's materials name (a texture, a cutout mask) are inputs too.

@@ -71,6 +71,27 @@ impl Checkpoint {
         write_atomically(path, &self.encode()?)
     }
 
+    /// Refuses a `path` that holds a file other than a checkpoint, before a render that saves its
+    /// checkpoint there: a slip (`--checkpoint notes.txt`) would replace that file. A missing or
+    /// empty file is taken (nothing to lose), and so is anything but a regular file, which the
+    /// writer refuses itself ([`crate::util::write::check_writable`]).
+    pub fn check_replaceable(path: &Path) -> Result<()> {
+        use std::io::Read;
+        if !std::fs::metadata(path).is_ok_and(|m| m.is_file() && m.len() > 0) {
+            return Ok(());
+        }
+        let mut head = Vec::with_capacity(MAGIC.len());
+        let read = std::fs::File::open(path).and_then(|file| file.take(MAGIC.len() as u64).read_to_end(&mut head));
+        read.map_err(|e| Error::io(path, e))?;
+        if head != MAGIC {
+            return Err(Error::invalid(format!(
+                "{}: the file exists and is not a lumiere checkpoint, which the render would replace; remove it or name another checkpoint",
+                shown_path(path)
+            )));
+        }
+        Ok(())
+    }
+
     pub fn load(path: &Path) -> Result<Checkpoint> {
         let bytes = crate::util::read::read_regular_file(path).map_err(|e| Error::io(path, e))?;
         Checkpoint::decode(&bytes, path)

@@ -26,7 +26,7 @@ use lumiere::scene::camera::Camera;
 use lumiere::util::write::write_atomically;
 use lumiere::world::World;
 
-use super::args::{ModeArg, RenderArgs, TonemapArg};
+use super::args::{ModeArg, RenderArgs, STDOUT_ARG, TonemapArg};
 use super::output;
 use report::Timings;
 
@@ -93,7 +93,7 @@ fn render(args: &RenderArgs, threads: usize, denoiser: Option<&oidn::Oidn>) -> R
     report::summary(&options, &camera, &output, threads, &args.output);
     if let Some(path) = &args.stats_json {
         let json = report::stats_json(&world, &options, &camera, &output, threads, &timings)?;
-        if path.as_os_str() == paths::STDOUT_ARG {
+        if path.as_os_str() == STDOUT_ARG {
             output::write_stdout(json.as_bytes())?;
         } else {
             write_atomically(path, json.as_bytes())?;

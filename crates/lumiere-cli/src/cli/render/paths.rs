@@ -7,15 +7,13 @@ use lumiere::error::shown_path;
 use std::path::{Path, PathBuf};
 
 use lumiere::image_io::check_output_path;
+use lumiere::render::checkpoint::Checkpoint;
 use lumiere::scene::Scene;
 use lumiere::util::overwrite::{Named, check_outputs, check_scene_files};
 use lumiere::util::write::{check_writable, remove_stale_temporaries};
 use lumiere::{Error, Result};
 
-use crate::cli::args::RenderArgs;
-
-/// `--stats-json -` writes the statistics to stdout.
-pub const STDOUT_ARG: &str = "-";
+use crate::cli::args::{RenderArgs, STDOUT_ARG};
 
 /// Refuses outputs that would clobber an input or each other, or that cannot be written; cleans
 /// stale temporaries beside them.
@@ -54,6 +52,9 @@ pub fn check(args: &RenderArgs) -> Result<()> {
     }
     // Continuing a checkpoint in place is the documented way to resume.
     check_outputs(&outputs, &inputs, Some(("--checkpoint", "--resume")))?;
+    if let Some(path) = &args.checkpoint {
+        Checkpoint::check_replaceable(path)?;
+    }
     for output in &outputs {
         remove_stale_temporaries(output.path.parent().unwrap_or(Path::new("")));
     }

@@ -250,7 +250,7 @@ def render_full(
     # Refused now, not once the render is done and the checkpoint cannot hold it.
     if checkpoint is not None:
         checkpoint = _path(checkpoint)
-        _lumiere.check_writable_output(checkpoint)
+        _lumiere.check_checkpoint_output(checkpoint)
     # Refused here, before connecting, rather than by every worker's thread pool.
     if threads_per_task > 1024:
         raise LumiereError(f"threads_per_task must be at most 1024 (as --threads), got {threads_per_task}")
