@@ -237,7 +237,7 @@ pub struct RenderArgs {
     #[arg(short, long, default_value = "render.png")]
     pub output: PathBuf,
 
-    /// Write PNGs as gKit does (floor(255*c), no gamma) for side-by-side comparison with gKit renders.
+    /// Write PNGs as gKit does (clamped, floor(255*c), no gamma) for side-by-side comparison with gKit renders; --tonemap aces still applies the curve first.
     #[arg(long)]
     pub png_linear: bool,
 
@@ -246,7 +246,7 @@ pub struct RenderArgs {
     pub exposure: Option<f32>,
 
     /// How the PNG maps radiance to the display: clamp (clip at 1, the lab's images) or aces (a
-    /// filmic curve). [default: aces for path, clamp for the lab's modes]
+    /// filmic curve). [default: aces for path, clamp for the lab's modes and with --png-linear]
     #[arg(long, value_enum)]
     pub tonemap: Option<TonemapArg>,
 

@@ -142,6 +142,24 @@ fn thread_count_does_not_change_the_bytes() {
     }
 }
 
+/// `--png-linear` writes as gKit does, and gKit clamps: in path mode too, whose default curve is
+/// ACES, unless `--tonemap aces` asks for the curve.
+#[test]
+fn png_linear_clamps_unless_told_to_tone_map() {
+    let dir = TempDir::new("png-linear");
+    let png = |name: &str, extra: &[&str]| {
+        let out = dir.path(name);
+        let args = ["render", "--mode", "path", "--spp", "2", "--size", "16x12", "--png-linear", "-o"];
+        let run = lumiere(&[&args[..], &[out.to_str().unwrap()], extra].concat());
+        assert!(run.status.success(), "{}", stderr(&run));
+        fs::read(out).unwrap()
+    };
+    let (plain, clamp, aces) =
+        (png("a.png", &[]), png("b.png", &["--tonemap", "clamp"]), png("c.png", &["--tonemap", "aces"]));
+    assert!(plain == clamp, "--png-linear alone does not clamp");
+    assert!(plain != aces, "--tonemap aces is ignored with --png-linear");
+}
+
 #[test]
 fn stats_json_has_the_promised_fields() {
     let dir = TempDir::new("stats");

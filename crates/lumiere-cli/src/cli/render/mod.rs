@@ -304,7 +304,8 @@ fn write_output(
 }
 
 fn png_style(args: &RenderArgs) -> PngStyle {
-    let filmic = args.mode == ModeArg::Path;
+    // gKit's PNGs are clamped: --png-linear, which writes as gKit does, clamps unless told otherwise.
+    let filmic = args.mode == ModeArg::Path && !args.png_linear;
     PngStyle {
         encoding: if args.png_linear { PngEncoding::GkitLinear } else { PngEncoding::Srgb },
         exposure: args.exposure.unwrap_or(0.0),
