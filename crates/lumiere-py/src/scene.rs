@@ -171,7 +171,7 @@ impl PyScene {
             entry.set_item("ke", material.ke.to_array())?;
             entry.set_item("texture", material.map_kd.as_ref().map(|p| p.display().to_string()))?;
             entry.set_item("texture_placement", placement(py, material.map_kd_transform)?)?;
-            entry.set_item("cutout", material.map_d.as_ref().map(|p| p.display().to_string()))?;
+            entry.set_item("cutout", material.cutout_mask().map(|p| p.display().to_string()))?;
             entry.set_item("cutout_placement", placement(py, material.map_d_transform)?)?;
             entry.set_item("light", material.is_emissive())?;
             materials.set_item(&material.name, entry)?;

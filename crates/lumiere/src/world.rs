@@ -7,7 +7,6 @@ use glam::{Vec2, Vec3};
 
 use crate::accel::simd::lanes_of;
 use crate::accel::{Accel, BuildPreset, Hit, Isa, OriginBatch, Region};
-use crate::error::shown_name;
 use crate::geometry::surface::SurfacePoint;
 use crate::geometry::surface_lanes::{HitCorners, SurfaceRows};
 use crate::lights::LightSet;
@@ -90,17 +89,9 @@ impl World {
         let (texture_of_material, textures, mut warnings) =
             TextureSet::for_materials(scene.materials.iter().map(|m| m.map_kd.as_deref()));
         let texture_of_material = placed(texture_of_material, scene.materials.iter().map(|m| m.map_kd_transform));
-        // Lights are sampled over their whole triangles, so an emitter stays whole for the rays
-        // that find it too: cut out, a BSDF-sampled ray would pass where light sampling adds
-        // emission, and the two strategies would disagree.
-        for emitter in scene.materials.iter().filter(|m| m.is_emissive() && m.map_d.is_some()) {
-            warnings.push(format!(
-                "material {}: map_d is ignored on an emitter; it stays opaque",
-                shown_name(&emitter.name)
-            ));
-        }
+        warnings.extend(scene.materials.iter().filter_map(Material::ignored_mask_warning));
         let (cutout_of_material, cutouts, cutout_warnings) =
-            TextureSet::for_cutouts(scene.materials.iter().map(|m| m.map_d.as_deref().filter(|_| !m.is_emissive())));
+            TextureSet::for_cutouts(scene.materials.iter().map(Material::cutout_mask));
         warnings.extend(cutout_warnings);
         let cutout_of_material = placed(cutout_of_material, scene.materials.iter().map(|m| m.map_d_transform));
         let diameter = scene.bounds().extent().length();

@@ -29,7 +29,10 @@ pub fn run(args: &InfoArgs) -> Result<()> {
     // Named as a render would name them, from their metadata: a render decodes them when it
     // builds the world, and a user asking why a surface comes out plain learns it here.
     let materials = &scene.materials;
-    let (map_kd, map_d) = (materials.iter().map(|m| m.map_kd.as_deref()), materials.iter().map(|m| m.map_d.as_deref()));
+    for warning in materials.iter().filter_map(Material::ignored_mask_warning) {
+        output::warn(warning);
+    }
+    let (map_kd, map_d) = (materials.iter().map(|m| m.map_kd.as_deref()), materials.iter().map(Material::cutout_mask));
     for warning in TextureSet::unreadable_files(map_kd, map_d) {
         output::warn(warning);
     }
@@ -91,7 +94,7 @@ fn describe(material: &Material) -> String {
             parts.push(format!("map_Kd {}{:?}", placement(material.map_kd_transform), texture.display().to_string()));
         }
     }
-    if let Some(mask) = &material.map_d {
+    if let Some(mask) = material.cutout_mask() {
         parts.push(format!("map_d {}{:?} (cutout)", placement(material.map_d_transform), mask.display().to_string()));
     }
     if material.is_emissive() {

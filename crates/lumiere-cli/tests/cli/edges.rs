@@ -635,6 +635,22 @@ fn info_names_materials_and_prints_no_negative_zero() {
     assert!(!text.contains("-0.000000"), "{text}");
 }
 
+/// `info` says what a render does with a mask on an emitter (ignores it, with the render's
+/// warning), where it listed the mask as a cutout and asked for its file.
+#[test]
+fn info_warns_as_a_render_of_a_mask_on_an_emitter() {
+    let dir = TempDir::new("info-emitter-mask");
+    dir.write("m.mtl", "newmtl lamp\nKe 1 1 1\nmap_d missing-mask.png\n");
+    let scene = dir.write("s.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl lamp\nf 1 2 3\n");
+    let warning = "warning: material 'lamp': map_d is ignored on an emitter; it stays opaque";
+    let render = run(&["render", "--size", "8x6", "--spp", "1", scene.to_str().unwrap(), "-o", &dir.arg("o.png")]);
+    assert!(render.status.success() && stderr(&render).contains(warning), "{}", stderr(&render));
+    let info = run(&["info", scene.to_str().unwrap()]);
+    let (text, message) = (String::from_utf8_lossy(&info.stdout), stderr(&info));
+    assert!(info.status.success() && message.contains(warning), "{message}");
+    assert!(!text.contains("cutout") && !message.contains("missing-mask.png"), "{text}{message}");
+}
+
 /// An existing output that its owner made read-only is refused and kept, as `cp` would refuse to
 /// write into it (the atomic rename alone would replace it). Root may write into any file, so
 /// when the tests run as root the binary runs as an unprivileged user.

@@ -9,8 +9,9 @@ use glam::Vec3;
 use super::conductor::is_smooth;
 use super::microfacet::MIN_ALPHA;
 use super::{Conductor, Dielectric, Lambert, MaterialBsdf, Mirror, Plastic};
+use crate::error::shown_name;
 use crate::math::UvTransform;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// The index of refraction of a transmissive material whose file gives none usable (ordinary
 /// glass). `Ni 1` counts as none: it is both our default and what exporters write when no index
@@ -148,6 +149,20 @@ impl Material {
 
     pub fn is_emissive(&self) -> bool {
         self.ke.max_element() > 0.0
+    }
+
+    /// The coverage texture that cuts the surface out: `map_d`, except on an emitter. Lights are
+    /// sampled over their whole triangles, so an emitter stays whole for the rays that find it
+    /// too: cut out, a BSDF-sampled ray would pass where light sampling adds emission, and the two
+    /// strategies would disagree.
+    pub fn cutout_mask(&self) -> Option<&Path> {
+        self.map_d.as_deref().filter(|_| !self.is_emissive())
+    }
+
+    /// The warning for a `map_d` that [`Material::cutout_mask`] leaves out, if there is one.
+    pub fn ignored_mask_warning(&self) -> Option<String> {
+        (self.map_d.is_some() && self.cutout_mask().is_none())
+            .then(|| format!("material {}: map_d is ignored on an emitter; it stays opaque", shown_name(&self.name)))
     }
 
     /// The one mapping from a material's statements to its kind of scattering, in this order
