@@ -151,6 +151,18 @@ impl Material {
         self.ke.max_element() > 0.0
     }
 
+    /// Clamps `kd` to [0, 1] where it lies outside: a reflectance above 1 would reflect more light
+    /// than arrives (below 0, take some away) in every lobe that reads it (diffuse, a metal's base
+    /// colour). Returns what was clamped, for the loader's warning.
+    pub fn clamp_kd(&mut self) -> Option<String> {
+        let clamped = self.kd.clamp(Vec3::ZERO, Vec3::ONE);
+        if clamped == self.kd {
+            return None;
+        }
+        let Vec3 { x, y, z } = std::mem::replace(&mut self.kd, clamped);
+        Some(format!("colour {x} {y} {z} clamped to [0, 1] (a surface reflects at most the light it receives)"))
+    }
+
     /// The coverage texture that cuts the surface out: `map_d`, except on an emitter. Lights are
     /// sampled over their whole triangles, so an emitter stays whole for the rays that find it
     /// too: cut out, a BSDF-sampled ray would pass where light sampling adds emission, and the two

@@ -85,18 +85,11 @@ impl Scene {
         if let Some(bad) = mesh.normals.iter().position(|n| !n.is_finite()) {
             return Err(Error::invalid(format!("{name}: normal {bad} is not finite")));
         }
-        // A reflectance outside [0, 1] would reflect more light than arrives (or take some away):
-        // every lobe that reads `kd` (diffuse, a metal's base colour) gets it clamped, once, named.
+        // The MTL loader clamps its colours where it can name their line; this catches the rest
+        // (materials given as arrays).
         for material in &mut materials {
-            let clamped = material.kd.clamp(Vec3::ZERO, Vec3::ONE);
-            if clamped != material.kd {
-                let Vec3 { x, y, z } = material.kd;
-                warnings.push(format!(
-                    "{name}: material {}: colour {x} {y} {z} clamped to [0, 1] (a surface reflects at most the \
-                     light it receives)",
-                    shown_name(&material.name)
-                ));
-                material.kd = clamped;
+            if let Some(clamped) = material.clamp_kd() {
+                warnings.push(format!("{name}: material {}: {clamped}", shown_name(&material.name)));
             }
         }
         Ok(Scene { name, mesh, materials, warnings, sources: Vec::new() })

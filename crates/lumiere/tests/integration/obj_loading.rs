@@ -252,7 +252,8 @@ fn missing_mtl_warns_and_uses_grey() {
 }
 
 /// A colour outside [0, 1] would reflect more light than arrives, or take some away: the scene
-/// keeps it clamped, with one warning naming the material; colours in range are kept as given.
+/// keeps it clamped, with one warning naming the MTL's line and the material; colours in range are
+/// kept as given.
 #[test]
 fn colours_outside_zero_to_one_are_clamped_and_named() {
     let dir = TempDir::new("kd-range");
@@ -264,7 +265,7 @@ fn colours_outside_zero_to_one_are_clamped_and_named() {
     assert_eq!(kd("fine"), Vec3::new(0.0, 0.25, 1.0));
     let named: Vec<&String> = scene.warnings.iter().filter(|w| w.contains("clamped to [0, 1]")).collect();
     assert_eq!(named.len(), 1, "{:?}", scene.warnings);
-    assert!(named[0].contains("material 'hot': colour -1 0.5 2"), "{}", named[0]);
+    assert!(named[0].ends_with("m.mtl:2: material \"hot\": colour -1 0.5 2 clamped to [0, 1] (a surface reflects at most the light it receives)"), "{}", named[0]);
 }
 
 #[test]

@@ -70,6 +70,11 @@ pub(super) fn parse_mtl(bytes: &[u8], path: &Path, warnings: &mut Warnings) -> V
                         note(&mut unsupported, option);
                     }
                     statement.apply(material);
+                    if let Some(clamped) = material.clamp_kd() {
+                        warnings.push(path, "clamped colours", || {
+                            format!("{}:{}: material {}: {clamped}", shown_path(path), i + 1, quote(&material.name))
+                        });
+                    }
                     continue;
                 }
                 None => "statement before the first newmtl".to_string(),
