@@ -131,6 +131,11 @@ impl PyScene {
         self.world.scene().warnings.iter().chain(self.world.warnings()).cloned().collect()
     }
 
+    /// Refuses a scene without a triangle, before a render (`Scene::check_has_faces`).
+    fn check_has_faces(&self) -> PyResult<()> {
+        self.world.scene().check_has_faces().or_py()
+    }
+
     /// What `lumiere info` prints, as a dict.
     fn info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let scene = self.world.scene();

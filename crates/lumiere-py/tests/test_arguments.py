@@ -50,6 +50,7 @@ def from_arrays(**kwargs):
         (lambda: render(aovs=[1]), r"aovs\[0\] must be a string, got 1"),
         (lambda: render(mode=5), "mode must be a string, got 5"),
         (lambda: from_arrays(name=5), "name must be a string, got 5"),
+        (lambda: lumiere.render(lumiere.Scene.from_arrays(VERTICES, np.zeros((0, 3), np.int64))), "the scene has no faces"),
         (lambda: write_image(tonemap=None), "tonemap must be a string, got None"),
         (lambda: from_arrays(materials=["a\udcffb"]), r"materials\[0\]\['name'\] must be valid Unicode text"),
         (lambda: from_arrays(name="a\udcffb"), "name must be valid Unicode text"),

@@ -277,6 +277,9 @@ def test_bad_arguments_are_refused_before_connecting(tmp_path):
     # A checkpoint that cannot be written is refused now, not after the render it would hold.
     with pytest.raises(lumiere.LumiereError, match="is a directory"):
         distributed.render(lumiere.builtin(), spp=2, checkpoint=tmp_path, address="127.0.0.1:9")
+    faceless = lumiere.Scene.from_arrays(np.zeros((3, 3), np.float32), np.zeros((0, 3), np.int64))
+    with pytest.raises(lumiere.LumiereError, match="the scene has no faces"):
+        distributed.render(faceless, spp=2, size=(8, 6), address="127.0.0.1:9")
     # A slip of the name must not replace a file that is not a checkpoint.
     (tmp_path / "notes.txt").write_text("a user's notes")
     with pytest.raises(lumiere.LumiereError, match="is not a lumiere checkpoint"):

@@ -635,6 +635,24 @@ fn info_names_materials_and_prints_no_negative_zero() {
     assert!(!text.contains("-0.000000"), "{text}");
 }
 
+/// A scene without a face renders nothing in any mode: refused, where a file of vertices alone
+/// rendered black with a warning about its emitters, and an empty one asked for a camera.
+#[test]
+fn a_scene_without_faces_is_refused() {
+    let dir = TempDir::new("no-faces");
+    for (name, text) in [("points.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n"), ("empty.obj", "")] {
+        let scene = dir.write(name, text);
+        let out = run(&["render", "--size", "8x6", "--mode", "ao", scene.to_str().unwrap(), "-o", &dir.arg("o.png")]);
+        assert_eq!(out.status.code(), Some(2), "{name}: {}", stderr(&out));
+        assert!(
+            stderr(&out).ends_with(&format!("{name}: the scene has no faces, so there is nothing to render\n")),
+            "{}",
+            stderr(&out)
+        );
+    }
+    assert!(!dir.path("o.png").exists());
+}
+
 /// `info` says what a render does with a mask on an emitter (ignores it, with the render's
 /// warning), where it listed the mask as a cutout and asked for its file.
 #[test]

@@ -85,6 +85,13 @@ def _options(
     return options
 
 
+def _check_scene(scene: Any) -> None:
+    """Refuses what cannot be rendered: not a :class:`Scene`, or a scene without a face."""
+    if not isinstance(scene, Scene):
+        raise TypeError(f"scene must be a lumiere.Scene (lumiere.load, lumiere.builtin), got {type(scene).__name__}")
+    scene._native.check_has_faces()
+
+
 def _camera(scene: Scene, camera: Optional[Camera], size: Optional[Tuple[int, int]]) -> Camera:
     if camera is not None:
         if size is not None:
@@ -118,8 +125,7 @@ def render_full(
     **technique_options: Any,
 ) -> RenderResult:
     """Like :func:`render`, returning the image, the AOVs and the statistics together."""
-    if not isinstance(scene, Scene):
-        raise TypeError(f"scene must be a lumiere.Scene (lumiere.load, lumiere.builtin), got {type(scene).__name__}")
+    _check_scene(scene)
     options = _options(mode, spp, seed, sampler, time, noise, technique_options)
     camera = _camera(scene, camera, size)
     if isinstance(aovs, str):

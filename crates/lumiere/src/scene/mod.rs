@@ -109,6 +109,15 @@ impl Scene {
         Ok(())
     }
 
+    /// Refuses, before a render, a scene without a triangle (a file of vertices alone, or an
+    /// empty one), which every mode would render black.
+    pub fn check_has_faces(&self) -> Result<()> {
+        if self.mesh.triangle_count() > 0 {
+            return Ok(());
+        }
+        Err(Error::invalid(format!("{}: the scene has no faces, so there is nothing to render", self.name)))
+    }
+
     pub fn bounds(&self) -> Aabb {
         Aabb::from_points(&self.mesh.positions)
     }

@@ -138,6 +138,7 @@ fn load_scene(args: &RenderArgs) -> Result<Scene> {
     for warning in &scene.warnings {
         output::warn(format_args!("{warning}"));
     }
+    scene.check_has_faces()?;
     Ok(scene)
 }
 

@@ -26,7 +26,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 import numpy as np
 
 from .. import _lumiere
-from .._render import Progress, RenderResult, _array, _camera, _check_progress, _options
+from .._render import Progress, RenderResult, _array, _camera, _check_progress, _check_scene, _options
 from .._scene import Camera, Scene, _integer, _path, _rebuild_camera, _rebuild_scene
 from ..errors import LumiereError
 
@@ -231,8 +231,7 @@ def render_full(
 ) -> RenderResult:
     """Like :func:`render`, returning the image and statistics (``tasks``: per task its first
     pass, passes, worker wall and CPU seconds, host and pid; ``seconds``: the driver's wall time)."""
-    if not isinstance(scene, Scene):
-        raise TypeError(f"scene must be a lumiere.Scene, got {type(scene).__name__}")
+    _check_scene(scene)
     if spp is None:
         raise LumiereError("spp must be given: a distributed render does a fixed number of passes")
     spp = _integer(spp, "spp", 1)
