@@ -177,8 +177,9 @@ impl Reader<'_> {
 }
 
 /// An option's value as a user names it, for the refusal's message: the technique's record
-/// (`AmbientOcclusion(AmbientOcclusion { samples: 2, distance: inf })`) as its `--mode` and
-/// settings (`--mode ao (samples: 2, distance: inf)`), the sampler's as its `--sampler` name.
+/// (`AmbientOcclusion(AmbientOcclusion { samples: 2, distance: inf })`) as its flags
+/// (`--mode ao --samples 2 --ao-distance inf`; settings no flag sets, in parentheses), the
+/// sampler's as its `--sampler` name.
 /// Anything else, or a description from another version that does not parse, stays as written.
 /// Only the message is reworded: the description itself keeps the records' Debug text, since it
 /// is what a checkpoint's options fingerprint hashes, and checkpoints already written must resume.
@@ -195,14 +196,39 @@ fn readable(key: &str, value: &str) -> String {
                 "Path" => "path",
                 _ => return value.to_string(),
             };
-            match rest.split_once('{').and_then(|(_, fields)| fields.rsplit_once('}')).map(|(f, _)| f.trim()) {
-                Some(fields) if !fields.is_empty() => format!("--mode {mode} ({fields})"),
-                _ => format!("--mode {mode}"),
+            let fields = rest.split_once('{').and_then(|(_, fields)| fields.rsplit_once('}')).map_or("", |(f, _)| f);
+            let (mut flags, mut others) = (format!("--mode {mode}"), Vec::new());
+            for (name, value) in fields.split(", ").filter_map(|field| field.trim().split_once(": ")) {
+                let value = kebab_case(value);
+                match name {
+                    "samples" => flags += &format!(" --samples {value}"),
+                    "light_sampling" => flags += &format!(" --light-sampling {value}"),
+                    "distance" => flags += &format!(" --ao-distance {value}"),
+                    "max_depth" => flags += &format!(" --max-depth {value}"),
+                    _ => others.push(format!("{} {value}", name.replace('_', "-"))),
+                }
             }
+            if others.is_empty() { flags } else { format!("{flags} ({})", others.join(", ")) }
         }
         "sampler" => value.to_ascii_lowercase(),
         _ => value.to_string(),
     }
+}
+
+/// A Debug value as a flag's value: an enum variant's CamelCase name in kebab case (`PerLight` ->
+/// `per-light`, the `--light-sampling` value), anything else (a number) as it is.
+fn kebab_case(value: &str) -> String {
+    if !value.starts_with(|c: char| c.is_ascii_uppercase()) {
+        return value.to_string();
+    }
+    let mut out = String::new();
+    for (i, c) in value.chars().enumerate() {
+        if c.is_ascii_uppercase() && i > 0 {
+            out.push('-');
+        }
+        out.push(c.to_ascii_lowercase());
+    }
+    out
 }
 
 /// The longest option value a refused resume quotes.

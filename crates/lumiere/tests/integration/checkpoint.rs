@@ -103,7 +103,7 @@ fn differing_options_name_each_key_once_with_both_values() {
     assert_eq!(
         differing_options(saved, now),
         [
-            "technique (checkpoint: --mode path (max_depth: 8, rr_depth: 5, strategy: Mis); now: --mode hits)",
+            "technique (checkpoint: --mode path --max-depth 8 (rr-depth 5, strategy mis); now: --mode hits)",
             "seed (checkpoint: 1; now: 2)",
             "sampler (checkpoint: (none); now: sobol)",
             "old (checkpoint: yes; now: (none))",
@@ -113,6 +113,16 @@ fn differing_options_name_each_key_once_with_both_values() {
         differing_options("technique: Direct(Direct {  })\n", "technique: Hits(Hits)\n"),
         ["technique (checkpoint: --mode direct; now: --mode hits)"],
         "a record without fields is its mode alone"
+    );
+    assert_eq!(
+        differing_options(
+            "technique: Direct(Direct { samples: 16, light_sampling: PerLight })\n",
+            "technique: AmbientOcclusion(AmbientOcclusion { samples: 16, distance: inf })\n"
+        ),
+        [
+            "technique (checkpoint: --mode direct --samples 16 --light-sampling per-light; now: --mode ao --samples 16 --ao-distance inf)"
+        ],
+        "settings are named by their flags, with the flags' values"
     );
 }
 
