@@ -31,7 +31,7 @@ pub enum Command {
 #[derive(Args, Debug)]
 pub struct BenchSamplerArgs {
     /// Image size, WIDTHxHEIGHT.
-    #[arg(long, value_parser = parse_size, default_value = "256x192")]
+    #[arg(long, value_parser = parse_size, default_value = "256x192", allow_hyphen_values = true)]
     pub size: (u32, u32),
 
     /// Samples of the converged reference image (1 to 65536).
@@ -39,7 +39,7 @@ pub struct BenchSamplerArgs {
     pub reference_samples: u32,
 
     /// Seeds averaged per measurement (1 to 1000).
-    #[arg(long, default_value_t = 4, value_parser = parse_seeds)]
+    #[arg(long, default_value_t = 4, value_parser = parse_seeds, allow_hyphen_values = true)]
     pub seeds: u64,
 }
 
@@ -74,7 +74,7 @@ pub struct BenchBvhArgs {
     pub scenes_dir: PathBuf,
 
     /// Thread counts to measure, comma-separated (each at most 1024; 0 = RAYON_NUM_THREADS if set, else one per core).
-    #[arg(long, value_delimiter = ',', default_value = "1,2", value_parser = parse_threads)]
+    #[arg(long, value_delimiter = ',', default_value = "1,2", value_parser = parse_threads, allow_hyphen_values = true)]
     pub threads: Vec<usize>,
 
     /// SIMD kernels of the BVH: avx512, avx2, sse2 or portable (default: the widest this CPU
@@ -87,7 +87,7 @@ pub struct BenchBvhArgs {
     pub repeats: usize,
 
     /// Seed of the shadow and diffuse rays.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, allow_hyphen_values = true)]
     pub seed: u64,
 
     /// Also write the results as JSON to this file.
@@ -160,13 +160,13 @@ pub struct RenderArgs {
     /// Longest path in segments from the camera, as Mitsuba counts (path only): 1 shows the
     /// emitters, 2 direct light, 8 up to seven bounces; 0 = no limit (Russian roulette ends paths).
     /// [default: 8]
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub max_depth: Option<u32>,
 
     /// Samples per camera sample, for direct and ao only: points on every light triangle (direct),
     /// points in total (direct with --light-sampling power), or directions (ao). A pixel traces
     /// samples x spp rays. [default: 16]
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..), allow_hyphen_values = true)]
     pub samples: Option<u32>,
 
     /// Camera samples per pixel, each a pass over the image: 1 is one ray through each pixel centre
@@ -174,7 +174,7 @@ pub struct RenderArgs {
     /// modes, or unlimited with --time or --noise: the render goes on until the budget is met]
     // 2^32 - 1 is the library's "until a budget stops it" (`RenderOptions::spp`), which leaving
     // --spp out asks for; as a number it would render without end.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(u32::MAX - 1)))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(u32::MAX - 1)), allow_hyphen_values = true)]
     pub spp: Option<u32>,
 
     /// Random number generator for the Monte Carlo modes. [default: sobol for path (about half
@@ -196,7 +196,7 @@ pub struct RenderArgs {
     pub emission: Vec<(String, Vec3)>,
 
     /// Image size, WIDTHxHEIGHT.
-    #[arg(long, value_parser = parse_size, default_value = "1024x768")]
+    #[arg(long, value_parser = parse_size, default_value = "1024x768", allow_hyphen_values = true)]
     pub size: (u32, u32),
 
     /// gKit orbiter camera file (c, p, r, s, optional f lines); the built-in scene uses gKit's 2022 one.
@@ -226,11 +226,11 @@ pub struct RenderArgs {
     pub isa: Option<Isa>,
 
     /// Worker threads, at most 1024; 0 = RAYON_NUM_THREADS if set, else one per core; 1 = serial.
-    #[arg(long, default_value_t = 0, value_parser = parse_threads)]
+    #[arg(long, default_value_t = 0, value_parser = parse_threads, allow_hyphen_values = true)]
     pub threads: usize,
 
     /// Seed of the random numbers; the same seed gives the same image bytes for any thread count.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, allow_hyphen_values = true)]
     pub seed: u64,
 
     /// Output image: .png (8-bit sRGB), .exr or .pfm (linear float).
@@ -419,7 +419,10 @@ fn parse_isa(s: &str) -> Result<Isa, String> {
 fn parse_emission(s: &str) -> Result<(String, Vec3), String> {
     // At the last `=`: a colour never holds one, a material name may (`python -m
     // lumiere.distributed` splits there too).
-    let (name, value) = s.rsplit_once('=').ok_or_else(|| format!("expected NAME=r,g,b, got '{s}'"))?;
+    let (name, value) = s
+        .rsplit_once('=')
+        .filter(|(name, _)| !name.is_empty())
+        .ok_or_else(|| format!("expected NAME=r,g,b, got '{s}'"))?;
     let ke = parse_vec3(value)?;
     if ke.min_element() < 0.0 {
         return Err(format!("emission must not be negative, got '{value}'"));

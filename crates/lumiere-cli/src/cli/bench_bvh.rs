@@ -15,7 +15,7 @@ use lumiere::{Error, Result};
 use super::args::BenchBvhArgs;
 use super::export::{export_ray_sets, prepare_export_dir};
 use super::output;
-use lumiere::util::threads::pool;
+use lumiere::util::threads::{pool, resolved};
 
 pub fn run(args: &BenchBvhArgs) -> Result<()> {
     let isa = super::isa::choose(args.isa)?;
@@ -35,7 +35,8 @@ pub fn run(args: &BenchBvhArgs) -> Result<()> {
     if let Some(dir) = &args.export_rays {
         prepare_export_dir(dir, &scenes.iter().map(|bench| bench.name).collect::<Vec<_>>())?;
     }
-    let threads: Vec<usize> = args.threads.clone();
+    // 0 is the count a pool of 0 starts (`RAYON_NUM_THREADS`, or one per core): the tables name it.
+    let threads: Vec<usize> = args.threads.iter().map(|&n| resolved(n)).collect();
     let mut builds = Vec::new();
     let mut traces = Vec::new();
     let mut json = Vec::new();

@@ -270,6 +270,19 @@ fn bad_inputs_give_a_clear_error_and_no_file() {
     assert_refused(&dir, &["render", "--size", "0x768"], "no pixels");
     assert_refused(&dir, &["render", "--size", "banana"], "WIDTHxHEIGHT");
     assert_refused(&dir, &["render", "--samples", "0"], "samples");
+    // A negative number is refused as a value of its flag, where clap took it for another flag
+    // and advised `-- -1`, which would have made it the scene's file name.
+    for (flag, value, expected) in [
+        ("--size", "-5x10", "'-5' is not a positive integer"),
+        ("--threads", "-1", "expected a thread count"),
+        ("--max-depth", "-1", "-1 is not in 0.."),
+        ("--spp", "-3", "-3 is not in 1.."),
+        ("--samples", "-2", "-2 is not in 1.."),
+        ("--seed", "-1", "for '--seed <SEED>'"),
+        ("--emission", "=5,5,5", "expected NAME=r,g,b, got '=5,5,5'"),
+    ] {
+        assert_refused(&dir, &["render", flag, value], expected);
+    }
     assert_refused(&dir, &["render", "--mode", "teapot"], "teapot");
     assert_refused(&dir, &["render", "--eye", "0,0,nan", "--target", "0,0,1"], "finite");
     assert_refused(&dir, &["render", "--isa", "mmx"], "unknown ISA \"mmx\" (expected portable, sse2, avx2, avx512)");

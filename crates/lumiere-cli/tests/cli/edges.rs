@@ -297,6 +297,17 @@ fn the_environments_thread_count_is_capped_as_the_flags() {
     assert!(stats.contains("\"threads\": 1024"), "{stats}");
     let out = lumiere().args(["info"]).env("RAYON_NUM_THREADS", "100000").output().unwrap();
     assert!(out.status.success(), "{}", stderr(&out));
+    // The benchmarks' tables name the count that ran, not the 0 that asked for it.
+    let json = dir.arg("bvh.json");
+    let out = lumiere()
+        .args(["bench-bvh", "--scenes", "cornell", "--threads", "0", "--repeats", "1", "--json", &json])
+        .env("RAYON_NUM_THREADS", "3")
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    let rows: serde_json::Value = serde_json::from_slice(&fs::read(dir.path("bvh.json")).unwrap()).unwrap();
+    let rows = rows.as_array().expect("a list of rows");
+    assert!(!rows.is_empty() && rows.iter().all(|row| row["threads"] == 3), "{rows:?}");
 }
 
 #[test]
