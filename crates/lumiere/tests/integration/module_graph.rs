@@ -14,7 +14,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ("sampler", &["util"]),
     ("textures", &["error", "math", "util"]),
     ("geometry", &["math"]),
-    ("materials", &["math", "sampling"]),
+    ("materials", &["error", "math", "sampling"]),
     ("accel", &["geometry", "math"]),
     ("scene", &["error", "materials", "math", "util"]),
     ("lights", &["geometry", "math", "sampling", "scene", "util"]),
