@@ -246,10 +246,8 @@ def render_full(
     _check_progress(progress)
     if resume and checkpoint is None:
         raise LumiereError("resume needs the checkpoint to resume from")
-    # Refused now, not once the render is done and the checkpoint cannot hold it.
     if checkpoint is not None:
         checkpoint = _path(checkpoint)
-        _lumiere.check_checkpoint_output(checkpoint)
     # Refused here, before connecting, rather than by every worker's thread pool.
     if threads_per_task > 1024:
         raise LumiereError(f"threads_per_task must be at most 1024 (as --threads), got {threads_per_task}")
@@ -259,6 +257,9 @@ def render_full(
     camera = _camera(scene, camera, size)
     if checkpoint is not None:
         _check_outputs([("checkpoint", checkpoint)], scene, "scene", camera, "camera")
+        # Refused now, not once the render is done and the checkpoint cannot hold it; after the
+        # check against the inputs, which names an input that the checkpoint would replace.
+        _lumiere.check_checkpoint_output(checkpoint)
     width, height = camera.size
     if resume and os.path.exists(checkpoint):
         film = _lumiere.NativeFilm.load_checkpoint(checkpoint, scene._native, camera._native, options)
