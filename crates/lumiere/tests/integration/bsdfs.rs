@@ -435,6 +435,32 @@ fn reflection_lobes_are_reciprocal() {
     }
 }
 
+/// At a view so grazing (`cos θo = 1e-25`) that `tan²θo` overflows in `f32`, Smith's `Λ(ωo)` is
+/// infinite and every GGX reflection's pdf, `G1(ωo) D / (4 cos θo)`, is 0. A sample must have a
+/// positive pdf (its path weight is `f cos / pdf`), so the lobes made of that reflection alone,
+/// the conductor and a plastic without a base colour, return none of these directions.
+#[test]
+fn ggx_samples_at_a_view_grazing_past_f32_have_positive_pdf() {
+    let wo = Vec3::new(1.0, 0.0, 1e-25);
+    for alpha in ROUGHNESSES {
+        assert_eq!(Ggx::new(alpha).lambda(wo), f32::INFINITY);
+        let lobes = [
+            ("conductor", MaterialBsdf::Conductor(Conductor::new(Vec3::ONE, alpha))),
+            ("plastic, black base", MaterialBsdf::Plastic(Plastic::new(Vec3::ZERO, Vec3::ONE, alpha))),
+        ];
+        for (name, bsdf) in lobes {
+            for i in 0..32 {
+                for j in 0..32 {
+                    let u = Vec2::new((i as f32 + 0.5) / 32.0, (j as f32 + 0.5) / 32.0);
+                    if let Some(s) = bsdf.sample(wo, u) {
+                        assert!(s.pdf > 0.0 && s.pdf.is_finite(), "{name}, α {alpha}, u {u}: pdf {}", s.pdf);
+                    }
+                }
+            }
+        }
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // White furnace
 
@@ -850,4 +876,18 @@ fn albedos_are_the_documented_colours() {
     let glass = Dielectric::new(1.5, colour);
     let expected = Vec3::splat(0.04) + colour * 0.96;
     assert!((glass.albedo() - expected).abs().max_element() < 1e-6, "{} vs {expected}", glass.albedo());
+}
+
+/// A conductor becomes a perfect mirror only when its roughness lies *below* the smallest GGX
+/// keeps, `MIN_ALPHA`, as `MaterialKind::Conductor` documents; at `MIN_ALPHA` itself GGX still
+/// holds it, and its lobe and its name say conductor.
+#[test]
+fn a_conductor_at_the_smallest_ggx_roughness_is_no_mirror() {
+    let colour = Vec3::new(0.9, 0.6, 0.3);
+    let at = MaterialKind::Conductor { alpha: MIN_ALPHA };
+    assert_eq!(at.bsdf(colour), MaterialBsdf::Conductor(Conductor::new(colour, MIN_ALPHA)));
+    assert_eq!(at.name(), "conductor");
+    let below = MaterialKind::Conductor { alpha: MIN_ALPHA.next_down() };
+    assert_eq!(below.bsdf(colour), MaterialBsdf::Mirror(Mirror::new(colour)));
+    assert_eq!(below.name(), "mirror");
 }

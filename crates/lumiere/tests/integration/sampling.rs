@@ -383,6 +383,21 @@ fn alias_table_rejects_nothing_to_sample() {
     assert_eq!((table.pmf(0), table.pmf(1)), (0.25, 0.75));
 }
 
+/// With a single item there is no choice to make: all of `u` is left over, and the remapped
+/// number is `u` itself, up to the largest `f32` below 1 (the remap is linear on the item's
+/// interval, here `[0, 1)`). A clamp tighter than `[0, 1)` would bend the top of the interval.
+#[test]
+fn alias_table_of_one_item_remaps_u_to_itself() {
+    let table = AliasTable::new(&[2.5f32]).unwrap();
+    let top = 1.0f32.next_down();
+    let us = (0..=1000).map(|k| k as f32 / 1000.0 * top).chain([top, top.next_down(), top.next_down().next_down()]);
+    for u in us {
+        let (choice, remapped) = table.sample_remapped(u);
+        assert_eq!((choice.index, choice.pmf), (0, 1.0));
+        assert_eq!(remapped, u, "u {u}");
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Multiple importance sampling
 

@@ -74,6 +74,28 @@ fn lambert_samples_agree_with_eval_and_pdf_and_conserve_energy() {
     }
 }
 
+/// Lambert is one-sided, on the side of the normal: a direction exactly on the horizon (`z = 0`)
+/// is not on it, so `wo` or `wi` there gives `f = 0`, and `wo` there a zero pdf, as below it.
+#[test]
+fn lambert_reflects_nothing_on_the_horizon() {
+    let bsdf = Lambert { reflectance: Vec3::new(0.8, 0.5, 0.2) };
+    let (up, flat) = (Vec3::new(0.0, 0.6, 0.8), Vec3::new(0.6, 0.8, 0.0));
+    for (wo, wi) in [(up, flat), (flat, up), (flat, flat)] {
+        assert_eq!((bsdf.eval(wo, wi), bsdf.pdf(wo, wi)), (Vec3::ZERO, 0.0), "wo {wo}, wi {wi}");
+    }
+}
+
+/// `u.x = 1`, on the closed square the warps accept, maps to a direction on the horizon, where the
+/// cosine density is 0. A sample must have a positive pdf, so Lambert returns none there.
+#[test]
+fn lambert_gives_no_sample_on_the_horizon() {
+    let bsdf = Lambert { reflectance: Vec3::new(0.8, 0.5, 0.2) };
+    for k in 0..=16 {
+        let u = Vec2::new(1.0, k as f32 / 16.0);
+        assert_eq!(bsdf.sample(Vec3::new(0.0, 0.6, 0.8), u), None, "u {u}");
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Lights
 
@@ -311,6 +333,24 @@ fn lights_do_not_emit_backwards() {
         let u = Vec2::new(k as f32 / 100.0, 0.37);
         assert!(lights.sample_li_on(0, above, u).is_none());
         assert_eq!(pdf_at(&lights, LightSelection::Uniform, above, 0, Vec3::new(0.0, 2.0, 0.0)), 0.0);
+    }
+}
+
+/// A scene without emitters has no light to choose, by either selection (and so no light
+/// sample). Uniform choice must not read the count 0 as lights to pick from: `n − 1` would wrap
+/// around and hand out light 0 of an empty list, with probability 1/0.
+#[test]
+fn a_scene_without_lights_offers_no_light_choice() {
+    let mut scene = light_scene();
+    for material in &mut scene.materials {
+        material.ke = Vec3::ZERO;
+    }
+    let lights = LightSet::new(&scene);
+    assert!(lights.is_empty());
+    for selection in [LightSelection::Uniform, LightSelection::Power] {
+        for u in [0.0, 0.5, 1.0f32.next_down()] {
+            assert_eq!(lights.choose_remapped(selection, u), None, "{selection:?}, u {u}");
+        }
     }
 }
 

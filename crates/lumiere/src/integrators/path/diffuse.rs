@@ -203,3 +203,33 @@ impl<const N: usize> DiffuseVertices<N> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use glam::{Vec2, Vec3};
+
+    use super::DiffuseVertices;
+    use crate::math::rows::set_row;
+
+    /// Russian roulette survives with probability `q` for survival numbers uniform on `[0, 1)`:
+    /// the numbers below `q` survive, `q` itself does not (`Path::scatter` ends the path for
+    /// `survival >= q`). Two lanes of a white Lambertian vertex seen head-on keep their throughput
+    /// at 1, so `q` is its cap, 0.95, exactly: one draws `q`, the other the number just below it.
+    #[test]
+    fn diffuse_roulette_ends_the_path_whose_number_equals_the_survival_probability() {
+        let q = 0.95f32;
+        let mut v = DiffuseVertices::<2>::default();
+        for (lane, survival) in [q, q.next_down()].into_iter().enumerate() {
+            set_row(&mut v.ng, lane, Vec3::Z);
+            set_row(&mut v.ns, lane, Vec3::Z);
+            set_row(&mut v.dir, lane, -Vec3::Z);
+            set_row(&mut v.throughput, lane, Vec3::ONE);
+            set_row(&mut v.reflectance, lane, Vec3::ONE);
+            v.scatter_point[lane] = Vec2::splat(0.5);
+            v.survival[lane] = survival;
+            v.roulette |= 1 << lane;
+        }
+        let out = v.scatter(|_, _| 0.0);
+        assert_eq!(out.continues, 0b10, "the number q ends the path, the one below it survives");
+    }
+}

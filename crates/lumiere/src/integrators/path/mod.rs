@@ -439,3 +439,31 @@ impl Integrator for Path {
         self.trace(world, &camera.rays, &camera.streams, camera.live, &mut ctx.rays)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::mis_light_weight_over_pdf;
+
+    /// The power heuristic's weight of the light sample over its density, `l / (l² + b²)`, in
+    /// `f64`, whose squares neither overflow nor underflow for any finite `f32` density.
+    fn weight_over_pdf(l: f32, b: f32) -> f64 {
+        let (l, b) = (f64::from(l), f64::from(b));
+        l / (l * l + b * b)
+    }
+
+    /// The one-division form `l / (l² + b²)` breaks where the `f32` squares do: both densities so
+    /// small that the sum underflows to 0, or an infinite light density (∞ / ∞). There the function
+    /// falls back on the power heuristic over `l`, which must give the same value: `l / (l² + b²)`
+    /// for tiny densities, and 0 for an infinite one (the weight 1 spread over an infinite density).
+    #[test]
+    fn mis_light_weight_over_pdf_holds_where_the_squares_underflow_or_overflow() {
+        for (l, b) in [(1e-30f32, 1e-30f32), (1e-30, 0.0), (2e-25, 5e-25), (1e-23, 1e-24)] {
+            assert_eq!(l * l + b * b, 0.0, "the squares of {l} and {b} underflow in f32");
+            let (got, want) = (f64::from(mis_light_weight_over_pdf(l, b)), weight_over_pdf(l, b));
+            assert!((got - want).abs() <= 1e-5 * want, "l {l}, b {b}: {got}, expected {want}");
+        }
+        for b in [0.0, 1.0, 1e30] {
+            assert_eq!(mis_light_weight_over_pdf(f32::INFINITY, b), 0.0, "l ∞, b {b}");
+        }
+    }
+}
