@@ -71,9 +71,12 @@ impl AliasTable {
     #[inline]
     pub fn sample_remapped(&self, u: f32) -> (DiscreteSample, f32) {
         let n = self.bins.len();
-        // f64: `u · n` is exact and stays below n for every f32 u < 1.
-        let scaled = f64::from(u.max(0.0)) * n as f64;
-        let bin = (scaled as usize).min(n - 1);
+        // `u` = 1 or above is read as the largest number below 1: the top of the last bin, where a
+        // bin that keeps its own item always would otherwise remap it to 0 / 0. f64: `u · n` is
+        // exact and stays below n for every f32 u < 1. Not `clamp`, which keeps a NaN: it reads as 0.
+        #[allow(clippy::manual_clamp)]
+        let scaled = f64::from(u.max(0.0).min(ONE_MINUS_EPSILON)) * n as f64;
+        let bin = scaled as usize;
         let fraction = scaled - bin as f64;
         let Bin { threshold, alias } = self.bins[bin];
         let t = f64::from(threshold);

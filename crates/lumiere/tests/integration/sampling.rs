@@ -398,6 +398,20 @@ fn alias_table_of_one_item_remaps_u_to_itself() {
     }
 }
 
+/// `u` = 1, which the closed square of the warps allows, is read in the last bin, and its
+/// remapped number stays a number in `[0, 1)`: it was 0 / 0 where the last bin keeps its own item
+/// (one item, or a last item heavier than the mean).
+#[test]
+fn alias_table_reads_u_of_one_in_its_last_bin() {
+    for weights in [&[1.0f32][..], &[1.0, 3.0], &[3.0, 1.0], &[1.0, 1.0, 1.0]] {
+        let table = AliasTable::new(weights).unwrap();
+        let (choice, remapped) = table.sample_remapped(1.0);
+        let (last, _) = table.sample_remapped(1.0f32.next_down());
+        assert_eq!(choice, last, "{weights:?}");
+        assert!((0.0..1.0).contains(&remapped), "{weights:?}: remapped {remapped}");
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Multiple importance sampling
 
