@@ -63,8 +63,9 @@ impl Bsdf for Dielectric {
         if self.eta == 1.0 {
             // No interface at all: Fresnel's R is 0 and Snell's law the identity. Written out so
             // that rounding cannot scatter a stray reflection or bend the ray.
-            let wi = -wo;
-            return Some(BsdfSample { f: self.tf / cos_o, wi, pdf: 1.0, flags: transmission });
+            // At a view within ~3e-39 of grazing, 1 / cos θo overflows: no sample, as below.
+            let (wi, f) = (-wo, self.tf / cos_o);
+            return f.is_finite().then_some(BsdfSample { f, wi, pdf: 1.0, flags: transmission });
         }
         // The relative index across the interface as light crossing it towards wo sees it.
         let eta = if wo.z > 0.0 { self.eta } else { 1.0 / self.eta };

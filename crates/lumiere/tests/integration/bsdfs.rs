@@ -631,6 +631,38 @@ fn total_internal_reflection_inside_at_grazing_angles() {
     assert!((weight - glass.tf / (1.0 / 1.5f32).powi(2)).abs().max_element() < 1e-4, "weight {weight}");
 }
 
+/// No sample for a `wo` in the surface's plane or not finite, and none carrying an infinite value
+/// where `R / cos θo` overflows `f32` (a view so grazing that Fresnel's `R` rounds to 1): a
+/// specular lobe must never hand the integrator a non-finite weight.
+#[test]
+fn dielectric_declines_degenerate_and_overflowing_views() {
+    let us = [Vec2::new(0.0, 0.5), Vec2::new(0.5, 0.5), Vec2::new(0.999, 0.5)];
+    for eta in [1.0f32, DEFAULT_IOR, 0.8] {
+        let glass = Dielectric::new(eta, Vec3::ONE);
+        let degenerate = [
+            Vec3::X,
+            Vec3::new(-0.6, 0.8, 0.0),
+            Vec3::new(0.6, 0.8, -0.0),
+            Vec3::new(f32::NAN, 0.0, 0.5),
+            Vec3::new(0.0, f32::INFINITY, -0.5),
+            Vec3::new(0.6, 0.0, f32::NAN),
+        ];
+        for wo in degenerate {
+            for u in us {
+                assert!(glass.sample(wo, u).is_none(), "η {eta}, wo {wo}: {:?}", glass.sample(wo, u));
+            }
+        }
+        // cos θo = ±1e-40: 1 / 1e-40 is beyond f32::MAX (and R is 1 in f32 for an interface:
+        // no light gets in, or total internal reflection).
+        for wo in [Vec3::new(1.0, 0.0, 1e-40), Vec3::new(0.0, -1.0, -1e-40)] {
+            for u in us {
+                let s = glass.sample(wo, u);
+                assert!(s.is_none_or(|s| s.f.is_finite() && s.pdf > 0.0), "η {eta}, wo {wo}: {s:?}");
+            }
+        }
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Fresnel
 
@@ -664,6 +696,19 @@ fn fresnel_matches_known_values() {
     let f0 = Vec3::new(0.9, 0.6, 0.3);
     assert!((fresnel_schlick(f0, 1.0) - f0).abs().max_element() < 1e-7);
     assert!((fresnel_schlick(f0, 0.0) - Vec3::ONE).abs().max_element() < 1e-7);
+}
+
+/// Refraction and Fresnel put the critical angle at the same place, `sin²θt ≥ 1`: where
+/// `fresnel_dielectric` reports total reflection, `refracted_cos` has no refracted direction. At
+/// an index-1 interface a grazing ray has `sin²θt = 1` exactly.
+#[test]
+fn refraction_ends_where_fresnel_reflects_everything() {
+    assert_eq!(fresnel_dielectric_polarised(0.0, 1.0), (1.0, 1.0));
+    assert_eq!(refracted_cos(0.0, 1.0), None);
+    // Just off grazing, a (nearly grazing) refracted direction exists and Fresnel lets light in.
+    let cos_t = refracted_cos(1e-3, 1.0).expect("refracts");
+    assert!((cos_t - 1e-3).abs() < 1e-4, "cos θt {cos_t}");
+    assert!(fresnel_dielectric(1e-3, 1.0) < 1.0);
 }
 
 // ---------------------------------------------------------------------------------------------
