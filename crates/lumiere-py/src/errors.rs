@@ -15,7 +15,16 @@ fn build(py: Python<'_>, error: &lumiere::Error) -> PyResult<PyErr> {
     let instance = match error {
         lumiere::Error::Io { path, source } => {
             let instance = errors.getattr("LumiereOSError")?.call1((error.to_string(),))?;
-            instance.setattr("errno", source.raw_os_error())?;
+            // An error lumiere words itself (an output's missing folder) carries no OS number:
+            // its kind gives the one the OS would have, as `errno` promises one.
+            let errno = match source.raw_os_error() {
+                Some(number) => Some(number),
+                None if source.kind() == std::io::ErrorKind::NotFound => {
+                    Some(py.import("errno")?.getattr("ENOENT")?.extract::<i32>()?)
+                }
+                None => None,
+            };
+            instance.setattr("errno", errno)?;
             instance.setattr("filename", path.display().to_string())?;
             instance
         }

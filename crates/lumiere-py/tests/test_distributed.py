@@ -249,7 +249,7 @@ def test_the_command_line_refuses_its_output_and_camera_before_connecting(tmp_pa
     base = [sys.executable, "-m", "lumiere.distributed", "render", "--address", "127.0.0.1:9", "--size", "8x6"]
     for extra, expected in (
         (["-o", str(tmp_path / "x.jpg")], ".jpg is not an image format"),
-        (["-o", str(tmp_path / "missing" / "x.png")], "No such file or directory"),
+        (["-o", str(tmp_path / "missing" / "x.png")], f"the folder {tmp_path / 'missing'} does not exist"),
         (["-o", str(tmp_path / "x.png"), "--exposure", "nan"], "exposure must be between -64 and 64 stops"),
         (["-o", str(tmp_path / "x.png"), "--eye", "0,1,3"], "--eye and --target go together"),
         (["-o", str(tmp_path / "x.png"), "--emission", "light.001=1,1,1", "--emission", "light.001=2,2,2"],

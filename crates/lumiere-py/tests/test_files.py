@@ -3,12 +3,14 @@ as lumiere.load reads scenes (a regular file only), and lumiere.distributed (its
 command line) refuses, before any render, an output that would replace an input, a file the scene
 reads, or another output. No Ray is needed: every refusal comes before the cluster is asked for."""
 
+import errno
 import os
 import re
 import subprocess
 import sys
 import textwrap
 
+import numpy as np
 import pytest
 
 import lumiere
@@ -58,6 +60,11 @@ def test_the_orbiter_is_read_as_a_regular_file_only(tmp_path):
     with pytest.raises(lumiere.LumiereOSError) as error:
         lumiere.Camera.orbiter(tmp_path / "missing.txt")
     assert error.value.errno == 2 and error.value.filename == str(tmp_path / "missing.txt")
+    # An output in a folder that does not exist names the folder, and is still ENOENT.
+    out = tmp_path / "no" / "such" / "x.png"
+    with pytest.raises(lumiere.LumiereOSError, match=f"the folder {tmp_path / 'no' / 'such'} does not exist") as error:
+        lumiere.write_image(str(out), np.zeros((2, 2, 3), np.float32))
+    assert error.value.errno == errno.ENOENT and error.value.filename == str(out)
 
 
 def test_the_render_function_never_writes_its_checkpoint_over_an_input(scene_files):

@@ -12,6 +12,7 @@ use lumiere::{Error, Result};
 
 use super::args::BenchLabArgs;
 use super::output;
+use super::technique_json::technique_json;
 use lumiere::util::threads::pool;
 
 /// One row of the lab's table: what was rendered and the lab's serial and parallel milliseconds.
@@ -125,7 +126,7 @@ pub fn run(args: &BenchLabArgs) -> Result<()> {
         // The lab's figures are of 1024x768 images: beside a --quick run's, a reader would divide them.
         let lab = |ms: f64| (!args.quick).then_some(ms);
         json.push(serde_json::json!({
-            "image": row.label, "mode": row.technique.name(), "technique": format!("{:?}", row.technique), "width": width, "height": height,
+            "image": row.label, "mode": row.technique.name(), "technique": technique_json(&row.technique), "width": width, "height": height,
             "repeats": repeats, "lab_serial_ms": lab(row.lab_serial_ms), "serial_ms": serial_ms,
             "lab_parallel_ms": lab(row.lab_parallel_ms), "parallel_ms": parallel_ms, "threads": all_cores,
             "rays": rays, "mrays_per_s": mrays,

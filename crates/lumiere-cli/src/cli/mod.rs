@@ -9,6 +9,7 @@ mod info;
 mod isa;
 pub mod output;
 mod render;
+mod technique_json;
 
 use lumiere::Result;
 

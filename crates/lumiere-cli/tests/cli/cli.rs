@@ -208,6 +208,30 @@ fn stats_json_has_the_promised_fields() {
     );
 }
 
+/// The statistics name each technique's options as the flags do, in an object a script can index
+/// (it held Rust's Debug text, `Path(Path { max_depth: 8, .. })`).
+#[test]
+fn stats_json_holds_the_techniques_options_by_their_flags_names() {
+    let dir = TempDir::new("stats-technique");
+    let out = dir.path("r.pfm");
+    let technique = |flags: &[&str]| {
+        let mut args = vec!["render", "--size", "8x6", "-o", out.to_str().unwrap(), "--stats-json", "-"];
+        args.extend_from_slice(flags);
+        let run = lumiere(&args);
+        assert!(run.status.success(), "{flags:?}: {}", stderr(&run));
+        serde_json::from_slice::<serde_json::Value>(&run.stdout).unwrap()["technique"].clone()
+    };
+    let path = technique(&["--mode", "path", "--spp", "1", "--max-depth", "3"]);
+    assert_eq!(path, serde_json::json!({"max_depth": 3, "rr_depth": 5, "strategy": "mis"}));
+    let direct = technique(&["--mode", "direct", "--samples", "2", "--light-sampling", "power"]);
+    assert_eq!(direct, serde_json::json!({"samples": 2, "light_sampling": "power"}));
+    let ao = technique(&["--mode", "ao", "--samples", "4", "--ao-distance", "0.5"]);
+    assert_eq!(ao, serde_json::json!({"samples": 4, "ao_distance": 0.5}));
+    // Unbounded (the default) is null: JSON has no infinity.
+    assert_eq!(technique(&["--mode", "ao"]), serde_json::json!({"samples": 16, "ao_distance": null}));
+    assert_eq!(technique(&["--mode", "shadows"]), serde_json::json!({}));
+}
+
 #[test]
 fn mcguire_box_renders_with_the_issue_camera() {
     let Some(scene) = crate::common::shared_scene("cornell-mcguire/CornellBox-Original.obj") else { return };
@@ -298,7 +322,10 @@ fn bad_inputs_give_a_clear_error_and_no_file() {
     let folder = std::env::temp_dir();
     let folder = folder.to_str().unwrap();
     for (path, expected) in [
-        ("/nonexistent-dir/x.png", "nonexistent-dir"),
+        (
+            "/nonexistent-dir/x.png",
+            "/nonexistent-dir/x.png: cannot be created: the folder /nonexistent-dir does not exist",
+        ),
         ("out.jpg", ".png"),
         (folder, "is a directory, expected a file name"),
     ] {

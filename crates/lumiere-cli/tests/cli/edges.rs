@@ -204,8 +204,8 @@ fn bad_outputs_and_counts_are_refused_before_the_work() {
         (vec!["bench", "--repeats", "4294967296"], "from 1 to 1000"),
         (vec!["bench", "--repeats", "0"], "from 1 to 1000"),
         (vec!["bench-bvh", "--scenes", "cornell", "--threads", "100000"], "at most 1024 threads"),
-        (vec!["bench", "--quick", "--json", &dir.arg("missing/x.json")], "No such file or directory"),
-        (vec!["bench-bvh", "--scenes", "cornell", "--json", &dir.arg("missing/x.json")], "No such file or directory"),
+        (vec!["bench", "--quick", "--json", &dir.arg("missing/x.json")], "missing does not exist"),
+        (vec!["bench-bvh", "--scenes", "cornell", "--json", &dir.arg("missing/x.json")], "missing does not exist"),
         (vec!["bench-sampler", "--size", "4x3", "--seeds", "0"], "from 1 to 1000"),
         (vec!["bench-sampler", "--size", "4x3", "--reference-samples", "0"], "from 1 to 65536"),
     ] {

@@ -68,13 +68,24 @@ fn create_temp(path: &Path) -> Result<(File, PathBuf)> {
                 return Ok((file, temp));
             }
             Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
-            Err(e) => return Err(Error::io(path, e)),
+            Err(e) => return Err(missing_folder(path).unwrap_or_else(|| Error::io(path, e))),
         }
     }
     Err(Error::invalid(format!(
         "{}: {TEMP_ATTEMPTS} names for a temporary file beside it are all taken; remove the .lumiere-*.tmp files there",
         shown_path(path)
     )))
+}
+
+/// The error for an output whose folder does not exist, if that is why a file cannot be created
+/// beside it: still an I/O error of kind `NotFound`, but where the OS said "x.png: No such file or
+/// directory" of the file the user meant to create, it names the folder that is missing.
+fn missing_folder(path: &Path) -> Option<Error> {
+    let folder = path.parent().filter(|p| !p.as_os_str().is_empty())?;
+    (!folder.exists()).then(|| {
+        let reason = format!("cannot be created: the folder {} does not exist", shown_path(folder));
+        Error::io(path, std::io::Error::new(std::io::ErrorKind::NotFound, reason))
+    })
 }
 
 /// Removes every temporary file this process is writing now. For a process about to exit at once

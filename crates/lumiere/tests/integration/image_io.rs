@@ -228,6 +228,10 @@ fn missing_directory_is_an_io_error_naming_the_path_and_leaves_nothing() {
     assert_io_error(write_image(&path, 1, 1, &[g(1.0)], PngEncoding::Srgb), &path);
     assert_io_error(write_atomically(&path, b"bytes"), &path);
     assert_io_error(check_output_path(&path), &path);
+    // The message names the folder that is missing, not only the file that could not be made.
+    let message = check_output_path(&path).unwrap_err().to_string();
+    let folder = dir.path("no/such/dir");
+    assert!(message.ends_with(&format!("the folder {} does not exist", folder.display())), "{message}");
     assert!(dir.entries().is_empty());
 }
 

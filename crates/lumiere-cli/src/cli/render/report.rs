@@ -15,6 +15,7 @@ use lumiere::world::World;
 use lumiere::{Error, Result};
 
 use crate::cli::output;
+use crate::cli::technique_json::technique_json;
 
 /// Milliseconds spent before rendering.
 pub struct Timings {
@@ -74,7 +75,7 @@ pub fn stats_json(
     let stats = serde_json::json!({
         "scene": world.scene().name,
         "mode": options.technique.name(),
-        "technique": format!("{:?}", options.technique),
+        "technique": technique_json(&options.technique),
         "samples": samples_per_camera_sample(&options.technique),
         "width": camera.width,
         "height": camera.height,
