@@ -161,7 +161,9 @@ impl Ggx {
     fn stretched_frame(&self, wo: Vec3) -> (Vec3, Vec3, Vec3) {
         let vh = Vec3::new(self.alpha * wo.x, self.alpha * wo.y, wo.z).normalize();
         let len2 = vh.x * vh.x + vh.y * vh.y;
-        let t1 = if len2 > 0.0 { Vec3::new(-vh.y, vh.x, 0.0) / len2.sqrt() } else { Vec3::X };
+        // A subnormal `len2` (`vh` within 1e-19 of the pole) keeps too few bits for its square root
+        // to normalise `t1`; there any horizontal vector is perpendicular to `vh` to `f32` precision.
+        let t1 = if len2 >= f32::MIN_POSITIVE { Vec3::new(-vh.y, vh.x, 0.0) / len2.sqrt() } else { Vec3::X };
         (vh, t1, vh.cross(t1))
     }
 

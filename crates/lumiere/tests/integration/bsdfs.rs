@@ -299,6 +299,62 @@ fn smith_terms_and_reflection_values_match_their_closed_forms() {
     }
 }
 
+/// `reflection()` is `None` unless both directions lie above the surface, as it documents, for
+/// the two pairs its sign tests alone would let through: both directions below (their half vector
+/// is below too, where `D` is 0), and two directions above the surface whose cosines multiply to 0
+/// in `f32` (1e-25 each), where `Λ` is infinite and the value `D G2 / (4 cos θo cos θi)` would be
+/// `D / (∞ · 0)`, NaN.
+#[test]
+fn ggx_reflection_is_none_below_and_where_the_cosine_product_underflows() {
+    let grazing = [Vec3::new(1.0, 0.0, 1e-25), Vec3::new(-0.6, 0.8, 1e-25)];
+    assert!(grazing[0].z > 0.0 && grazing[1].z > 0.0 && grazing[0].z * grazing[1].z == 0.0);
+    let below = [Vec3::new(0.3, -0.4, -0.866_025_4), Vec3::NEG_Z, Vec3::new(-0.6, 0.0, -0.8)];
+    for alpha in ROUGHNESSES {
+        let ggx = Ggx::new(alpha);
+        assert_eq!(ggx.reflection(grazing[0], grazing[1]), None, "α {alpha}: cosines underflow");
+        for a in below {
+            for b in below {
+                assert_eq!(ggx.reflection(a, b), None, "α {alpha}: {a} and {b} below");
+            }
+            assert_eq!(ggx.reflection(a, Vec3::Z), None, "α {alpha}: wo {a} below");
+            assert_eq!(ggx.reflection(Vec3::Z, a), None, "α {alpha}: wi {a} below");
+        }
+    }
+}
+
+/// A view within 1e-19 of the normal samples the lobe of normal incidence. At normal incidence
+/// (`u` read as the disk point `r = √u₁`), the sampled normal is the unstretched
+/// `(α p, √(1 − u₁))`, so `cos θm = √(1 − u₁) / √(α² u₁ + 1 − u₁)` whatever `u₂`; a view tilted by
+/// at most 1e-19 rad has that distribution to `f32` precision. The horizontal frame vector around
+/// such a view was divided by the square root of a subnormal `|vh.xy|²`, which keeps only a few
+/// bits, and came out of length 0.8 to 1.01 instead of 1, squashing or widening the lobe.
+#[test]
+fn visible_normals_next_to_normal_incidence_keep_the_lobe_of_normal_incidence() {
+    let mut worst = 0.0f64;
+    for alpha in ROUGHNESSES {
+        let ggx = Ggx::new(alpha);
+        let a2 = (alpha as f64).powi(2);
+        for tilt in [1e-22f32, 3e-22, 1e-21, 3e-21, 1e-20, 1e-19] {
+            let wo = Vec3::new(tilt, 0.5 * tilt, 1.0);
+            assert_eq!(wo.length(), 1.0);
+            for i in 0..16 {
+                for j in 0..16 {
+                    let u = Vec2::new((i as f32 + 0.5) / 16.0, (j as f32 + 0.5) / 16.0);
+                    let m = ggx.sample_visible_normal(wo, u);
+                    let u1 = u.x as f64;
+                    let expected = (1.0 - u1).sqrt() / (a2 * u1 + 1.0 - u1).sqrt();
+                    worst = worst.max((m.z as f64 - expected).abs());
+                    assert!(
+                        (m.z as f64 - expected).abs() < 1e-5 && (m.length() - 1.0).abs() < 1e-5,
+                        "α {alpha}, wo {wo}, u {u}: m {m}, expected cos θm {expected}"
+                    );
+                }
+            }
+        }
+    }
+    println!("worst |cos θm − expected|: {worst:e}");
+}
+
 // ---------------------------------------------------------------------------------------------
 // Sampling agrees with pdf
 
@@ -811,6 +867,19 @@ fn material_mapping_edges() {
     assert_eq!(alpha_from_ns(0.0), 1.0);
     assert!((alpha_from_ns(198.0) - 0.1).abs() < 1e-6);
     assert_eq!(alpha_from_ns(f32::NAN), 1.0);
+}
+
+/// A NaN `Pr` counts as absent (the MTL loader passes finite numbers only, but `Material` is
+/// public): `α` comes from `Ns` by `α = √(2 / (Ns + 2))`, as for a PBR material without `Pr`,
+/// rather than a NaN roughness for the lobe to guess at.
+#[test]
+fn a_nan_roughness_takes_alpha_from_ns() {
+    let alpha = (2.0f32 / (98.0 + 2.0)).sqrt();
+    let kind = |metallic: Option<f32>| {
+        material("m", |m| (m.metallic, m.roughness, m.ns) = (metallic, Some(f32::NAN), 98.0)).kind()
+    };
+    assert_eq!(kind(Some(1.0)), MaterialKind::Conductor { alpha });
+    assert_eq!(kind(None), MaterialKind::Plastic { ks: Vec3::splat(0.04), alpha });
 }
 
 /// The built-in gKit box (Ks 0.5 everywhere, no illum) and McGuire's (illum 2, Ks 0) are
