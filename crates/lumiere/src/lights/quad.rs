@@ -95,17 +95,14 @@ fn quad_of(lights: &[AreaLight], first: u32, second: u32, edge: usize) -> Option
     let b = (0..3).find(|&k| l2.vertices[k] != l1.vertices[u] && l2.vertices[k] != l1.vertices[v])?;
     // Around the quad: a, v, b, u (a and b are opposite corners, as are the shared u and v). Were
     // a and b on one side of the shared edge, this would cross itself and fail the convexity test.
+    // The walk goes from a to v, against the first triangle's winding (u, v, a), so it turns
+    // clockwise about the normal: a strictly convex quad turns the negative way at every corner.
     let positions = [l1.vertices[a], l1.vertices[v], l2.vertices[b], l1.vertices[u]];
-    let turns = (0..4).map(|k| {
+    let strictly_convex = (0..4).all(|k| {
         let (p, q, r) = (positions[k], positions[(k + 1) % 4], positions[(k + 2) % 4]);
-        (q - p).cross(r - q).dot(l1.normal)
+        (q - p).cross(r - q).dot(l1.normal) < 0.0
     });
-    let (mut positive, mut negative) = (0, 0);
-    for turn in turns {
-        positive += usize::from(turn > 0.0);
-        negative += usize::from(turn < 0.0);
-    }
-    if positive != 4 && negative != 4 {
+    if !strictly_convex {
         return None;
     }
     let corners = [l1.shadow_targets[a], l1.shadow_targets[v], l2.shadow_targets[b], l1.shadow_targets[u]];

@@ -336,6 +336,59 @@ fn lights_do_not_emit_backwards() {
     }
 }
 
+/// An area light's own geometry, exactly, for the dim light of `light_scene` (corners
+/// (-1, 2, -1), (1, 2, -1), (0, 2, 1), facing down, `Ke` 2, area 2): the centroid is the mean of
+/// the corners, barycentrics (1, 0, 0), (0, 1, 0), (0, 0, 1) read the three shadow targets, which
+/// lie a few ulps below the corners, the hard-shadow target is their centroid, and the flux is
+/// `π A Ke`. Other tests see these only through renders, ratios and statistics, which a centroid
+/// off by a factor of 9 (`/ 3` read as `* 3`) passed.
+#[test]
+fn an_area_lights_centroid_targets_and_power_are_exact() {
+    let lights = LightSet::new(&light_scene());
+    let light = lights.lights()[0];
+    assert_eq!((light.normal, light.area, light.emission), (Vec3::NEG_Y, 2.0, Vec3::splat(2.0)));
+    assert_eq!(light.centroid(), Vec3::new(0.0, 2.0, -1.0 / 3.0));
+    for (k, b) in [Vec3::X, Vec3::Y, Vec3::Z].into_iter().enumerate() {
+        assert_eq!(light.shadow_target(b), light.shadow_targets[k], "barycentrics {b}");
+        let moved = light.shadow_targets[k] - light.vertices[k];
+        assert!(moved.x == 0.0 && moved.z == 0.0 && moved.y < 0.0 && moved.y > -1e-4, "target {k} moved {moved}");
+    }
+    let hard = light.hard_shadow_target();
+    assert!(hard.y < 2.0 && hard.distance(light.centroid()) < 1e-4, "hard-shadow target {hard}");
+    let flux = (PI * 2.0 * 2.0) as f32;
+    assert_eq!(light.power(), Vec3::splat(flux));
+    assert!((light.power_weight() - 3.0 * PI * 4.0).abs() < 1e-5, "{}", light.power_weight());
+}
+
+/// Emission is one-sided and the side is strict: a direction along the light's plane (a cosine
+/// of exactly 0) gets nothing, as one behind it does; one just below the plane gets `Ke`.
+#[test]
+fn lights_emit_nothing_along_their_plane() {
+    let lights = LightSet::new(&light_scene());
+    let light = lights.lights()[0];
+    assert_eq!(light.radiance_towards(Vec3::NEG_Y), Vec3::splat(2.0));
+    assert_eq!(light.radiance_towards(Vec3::new(0.6, -0.01, 0.8).normalize()), Vec3::splat(2.0));
+    for w in [Vec3::Y, Vec3::X, Vec3::new(0.6, 0.0, -0.8)] {
+        assert_eq!(light.radiance_towards(w), Vec3::ZERO, "towards {w}");
+    }
+}
+
+/// `u` = 1, the closed end of the unit interval, stays in the list of lights by either selection
+/// (the alias table reads it as the largest number below 1): uniform choice picks the last light,
+/// with its probability and a remapped number below 1, never an index one past the end.
+#[test]
+fn light_choice_at_u_one_stays_in_the_list() {
+    let lights = LightSet::new(&light_scene());
+    let (index, pmf, remapped) = lights.choose_remapped(LightSelection::Uniform, 1.0).unwrap();
+    assert_eq!((index, pmf), (1, 0.5));
+    assert!((0.0..1.0).contains(&remapped), "remapped {remapped}");
+    let (index, _, remapped) = lights.choose_remapped(LightSelection::Power, 1.0).unwrap();
+    assert!(index < 2 && (0.0..1.0).contains(&remapped), "power: light {index}, remapped {remapped}");
+    let below = Vec3::new(0.2, 0.0, 0.1);
+    let sample = lights.sample_li_reusing(LightSelection::Uniform, below, Vec2::new(1.0, 0.5)).expect("a sample");
+    assert_eq!(sample.light, 1);
+}
+
 /// A scene without emitters has no light to choose, by either selection (and so no light
 /// sample). Uniform choice must not read the count 0 as lights to pick from: `n − 1` would wrap
 /// around and hand out light 0 of an empty list, with probability 1/0.

@@ -175,6 +175,64 @@ fn absurd_coordinates_read_a_texel_without_panicking() {
     assert!(Texture::from_linear(0, 0, vec![], None).is_none(), "empty");
 }
 
+/// A texture from linear values takes an alpha channel of exactly one value per texel, and
+/// filters it as it filters colour.
+#[test]
+fn linear_textures_take_an_alpha_of_one_value_per_texel() {
+    let rgb = || vec![Vec3::splat(0.5); 6];
+    let alpha = vec![0.0, 0.25, 0.5, 0.75, 1.0, 0.5];
+    let texture = Texture::from_linear(3, 2, rgb(), Some(alpha.clone())).expect("sizes match");
+    assert!(texture.has_alpha());
+    for (i, &a) in alpha.iter().enumerate() {
+        let (x, y) = (i as u32 % 3, i as u32 / 3);
+        let got = texture.sample_alpha(centre(x, y, 3, 2));
+        assert!((got - a).abs() < 1e-6, "texel ({x}, {y}): {got} vs {a}");
+    }
+    assert!(Texture::from_linear(3, 2, rgb(), Some(vec![1.0; 5])).is_none(), "alpha too short");
+    assert!(Texture::from_linear(3, 2, rgb(), Some(vec![1.0; 7])).is_none(), "alpha too long");
+}
+
+/// 8-bit files keep their codes, 4 bytes a texel (RGB and a padding byte), a third of the 12 of
+/// linear `f32` RGB that 16-bit files and linear textures take; alpha adds 4 bytes a texel.
+#[test]
+fn eight_bit_textures_keep_their_codes_in_a_third_of_the_memory() {
+    let dir = TempDir::new("textures-memory-bytes");
+    let rgb8 = dir.path("rgb8.png");
+    test_image().save_with_format(&rgb8, ImageFormat::Png).unwrap();
+    let rgba8 = dir.path("rgba8.png");
+    RgbaImage::from_fn(2, 2, |x, y| Rgba([10, 20, 30, (x + y) as u8]))
+        .save_with_format(&rgba8, ImageFormat::Png)
+        .unwrap();
+    let rgb16 = dir.path("rgb16.png");
+    image::ImageBuffer::<Rgb<u16>, Vec<u16>>::from_fn(2, 1, |x, _| Rgb([x as u16 * 40_000, 1000, 65_535]))
+        .save_with_format(&rgb16, ImageFormat::Png)
+        .unwrap();
+    assert_eq!(load_one(&rgb8).memory_bytes(), 4 * 3 * 4);
+    assert_eq!(load_one(&rgba8).memory_bytes(), 2 * 2 * (4 + 4));
+    assert_eq!(load_one(&rgb16).memory_bytes(), 2 * 12);
+    let linear = Texture::from_linear(3, 2, vec![Vec3::ONE; 6], Some(vec![1.0; 6])).unwrap();
+    assert_eq!(linear.memory_bytes(), 6 * (12 + 4));
+    let (set, _) = TextureSet::load(&[&rgb8, &rgba8, &rgb16]);
+    assert_eq!(set.memory_bytes(), 48 + 32 + 24);
+}
+
+/// Each id of a set names its own texture: the second of two different files reads the second
+/// file's texels, not the first's.
+#[test]
+fn each_texture_id_reads_its_own_texture() {
+    let dir = TempDir::new("textures-ids");
+    let (first, second) = (dir.path("first.png"), dir.path("second.png"));
+    RgbImage::from_pixel(1, 1, Rgb([255, 0, 0])).save_with_format(&first, ImageFormat::Png).unwrap();
+    RgbImage::from_pixel(1, 1, Rgb([0, 0, 255])).save_with_format(&second, ImageFormat::Png).unwrap();
+    let (set, warnings) = TextureSet::load(&[&first, &second]);
+    assert!(warnings.is_empty(), "{warnings:?}");
+    let (a, b) = (set.id_of(&first).unwrap(), set.id_of(&second).unwrap());
+    assert_eq!((a.index(), b.index()), (0, 1));
+    assert_eq!(set.sample(a, Vec2::splat(0.5)), Vec3::X);
+    assert_eq!(set.sample(b, Vec2::splat(0.5)), Vec3::Z);
+    assert_eq!(set.get(b).texel(0, 0), Vec3::Z);
+}
+
 #[test]
 fn jpeg_textures_decode_to_linear_values() {
     let dir = TempDir::new("textures-jpeg");
@@ -353,22 +411,23 @@ fn the_staircase_textures_decode() {
 fn coverage_is_the_alpha_or_the_stored_grey_at_either_depth() {
     use image::{ImageBuffer, Luma};
     let dir = TempDir::new("textures-coverage");
-    let levels = [0u8, 64, 128, 200, 255];
+    // Level 5 lies on the sRGB curve's linear segment (5/255 < 0.04045), the others on its power.
+    let levels = [0u8, 5, 64, 128, 200, 255];
     let grey8 = dir.path("grey8.png");
-    ImageBuffer::from_fn(5, 1, |x, _| Luma([levels[x as usize]])).save_with_format(&grey8, ImageFormat::Png).unwrap();
+    ImageBuffer::from_fn(6, 1, |x, _| Luma([levels[x as usize]])).save_with_format(&grey8, ImageFormat::Png).unwrap();
     let grey16 = dir.path("grey16.png");
-    ImageBuffer::from_fn(5, 1, |x, _| Luma([u16::from(levels[x as usize]) * 257]))
+    ImageBuffer::from_fn(6, 1, |x, _| Luma([u16::from(levels[x as usize]) * 257]))
         .save_with_format(&grey16, ImageFormat::Png)
         .unwrap();
     let rgba = dir.path("rgba.png");
     // Black colour, alpha from the levels: only the alpha may count.
-    RgbaImage::from_fn(5, 1, |x, _| Rgba([0, 0, 0, levels[x as usize]]))
+    RgbaImage::from_fn(6, 1, |x, _| Rgba([0, 0, 0, levels[x as usize]]))
         .save_with_format(&rgba, ImageFormat::Png)
         .unwrap();
     for path in [&grey8, &grey16, &rgba] {
         let texture = load_one(path);
         for (x, &level) in levels.iter().enumerate() {
-            let coverage = texture.sample_coverage(centre(x as u32, 0, 5, 1));
+            let coverage = texture.sample_coverage(centre(x as u32, 0, 6, 1));
             let expected = f32::from(level) / 255.0;
             assert!((coverage - expected).abs() < 1e-4, "{}: texel {x}: {coverage} vs {expected}", path.display());
         }
