@@ -68,7 +68,11 @@ fn create_temp(path: &Path) -> Result<(File, PathBuf)> {
                 return Ok((file, temp));
             }
             Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
-            Err(e) => return Err(missing_folder(path).unwrap_or_else(|| Error::io(path, e))),
+            // Only for NotFound: a folder that cannot be searched also fails `exists`.
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                return Err(missing_folder(path).unwrap_or_else(|| Error::io(path, e)));
+            }
+            Err(e) => return Err(Error::io(path, e)),
         }
     }
     Err(Error::invalid(format!(
