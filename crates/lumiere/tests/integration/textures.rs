@@ -40,6 +40,11 @@ fn test_image() -> RgbImage {
     })
 }
 
+/// A 2x1 image of 16-bit channels, codes the 8-bit range cannot hold (40,000, 1,000, 65,535).
+fn deep_image() -> image::ImageBuffer<Rgb<u16>, Vec<u16>> {
+    image::ImageBuffer::from_fn(2, 1, |x, _| Rgb([x as u16 * 40_000, 1000, 65_535]))
+}
+
 fn load_one(path: &Path) -> Texture {
     let (set, warnings) = TextureSet::load(&[path]);
     assert!(warnings.is_empty(), "{warnings:?}");
@@ -204,9 +209,7 @@ fn eight_bit_textures_keep_their_codes_in_a_third_of_the_memory() {
         .save_with_format(&rgba8, ImageFormat::Png)
         .unwrap();
     let rgb16 = dir.path("rgb16.png");
-    image::ImageBuffer::<Rgb<u16>, Vec<u16>>::from_fn(2, 1, |x, _| Rgb([x as u16 * 40_000, 1000, 65_535]))
-        .save_with_format(&rgb16, ImageFormat::Png)
-        .unwrap();
+    deep_image().save_with_format(&rgb16, ImageFormat::Png).unwrap();
     assert_eq!(load_one(&rgb8).memory_bytes(), 4 * 3 * 4);
     assert_eq!(load_one(&rgba8).memory_bytes(), 2 * 2 * (4 + 4));
     assert_eq!(load_one(&rgb16).memory_bytes(), 2 * 12);
@@ -277,9 +280,8 @@ fn alpha_is_kept_linear_and_sixteen_bit_pngs_decode_exactly() {
         assert!((texture.sample_alpha(uv) - p.0[3] as f32 / 255.0).abs() < 1e-5, "alpha at ({x}, {y})");
         assert!(close(texture.sample(uv), linear_rgb([255, 128, 0]), 1e-5));
     }
-    let deep = image::ImageBuffer::<Rgb<u16>, Vec<u16>>::from_fn(2, 1, |x, _| Rgb([x as u16 * 40_000, 1000, 65_535]));
     let path = dir.path("deep.png");
-    deep.save_with_format(&path, ImageFormat::Png).unwrap();
+    deep_image().save_with_format(&path, ImageFormat::Png).unwrap();
     let texture = load_one(&path);
     let expected = |c: u16| srgb_to_linear(c as f32 / 65535.0);
     assert!(close(texture.texel(1, 0), Vec3::new(expected(40_000), expected(1000), 1.0), 1e-7));
