@@ -121,7 +121,7 @@ struct Tile<'a, 'b> {
 
 /// Shades the pixels of `tile` block by block (4x4 pixels, [`PACKET`] lanes, traced together where
 /// the integrator can); the rays traced, or `None` if `stop_now` stopped it (checked before every
-/// block).
+/// block and after the last).
 fn shade_tile<I: Integrator>(
     integrator: &I,
     world: &World,
@@ -171,6 +171,12 @@ fn shade_tile<I: Integrator>(
             }
             pixels += u64::from(live.count_ones());
         }
+    }
+    // An integrator that saw the stop inside the tile's last block returned early, leaving part of
+    // its pixels' samples out: the tile is not whole. The flags never clear, so a stop unseen here
+    // was not seen inside the blocks either.
+    if stop_now().is_some() {
+        return None;
     }
     progress(pixels);
     Some(ctx.rays)

@@ -166,6 +166,37 @@ fn a_pass_stopped_midway_leaves_the_film_as_it_was() {
     }
 }
 
+/// A stop that an integrator sees inside a tile's last block (here the only block: a 4x4 image, a
+/// single tile) cuts that block's samples short, so the pass is not whole and must be dropped,
+/// whether the stop is the time budget or a cancel. Each pixel asks for 2^30 ambient-occlusion
+/// probes, seconds of work, so the stop always comes inside the block. The film was taking the
+/// cut pass as whole: pixels of about 1e-7 where the image is about 0.2.
+#[test]
+fn a_stop_inside_a_tiles_last_block_drops_the_pass() {
+    let world = World::new(Scene::builtin().unwrap(), Default::default());
+    let camera = Camera::from_orbiter(&builtin::cornell_orbiter().unwrap(), 4, 4);
+    let mut options = RenderOptions { spp: 2, ..RenderOptions::new(Technique::ambient_occlusion(1 << 30)) };
+    options.time_budget = Some(std::time::Duration::from_millis(50));
+    let never = AtomicBool::new(false);
+    let hooks = Hooks { progress: &|_| {}, pass_done: &mut |_, _| Ok(()), cancel: &never };
+    let film = Film::new(camera.width, camera.height).unwrap();
+    let stopped = render_progressive(&world, &camera, &options, film, RenderStats::default(), hooks).unwrap();
+    assert_eq!((stopped.stop, stopped.film.samples), (StopReason::TimeBudget, 0));
+
+    options.time_budget = None;
+    let cancel = AtomicBool::new(false);
+    let stopped = std::thread::scope(|scope| {
+        scope.spawn(|| {
+            std::thread::sleep(std::time::Duration::from_millis(50));
+            cancel.store(true, Ordering::Relaxed);
+        });
+        let hooks = Hooks { progress: &|_| {}, pass_done: &mut |_, _| Ok(()), cancel: &cancel };
+        let film = Film::new(camera.width, camera.height).unwrap();
+        render_progressive(&world, &camera, &options, film, RenderStats::default(), hooks).unwrap()
+    });
+    assert_eq!((stopped.stop, stopped.film.samples), (StopReason::Interrupted, 0));
+}
+
 /// The noise estimate against its definition, written out plainly: the root mean square over
 /// pixels of the standard error of each pixel's mean luminance (the unbiased sample variance over
 /// n), divided by the image's mean luminance; none before two samples, 0 for a black image.

@@ -1,7 +1,7 @@
 //! Pass ranges rendered apart and added in pass order give the bytes of a render made in one go,
 //! whatever the split and the order the ranges finish in; that is what distributed renders rely on.
 
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use lumiere::integrators::{AmbientOcclusion, Hits, Path, Technique};
 use lumiere::render::film::{Film, PassSamples};
@@ -68,6 +68,24 @@ fn a_cancelled_range_returns_whole_passes_only() {
     let cancel = AtomicBool::new(true);
     let passes = render_pass_range(&world, &camera, &options, 0, 4, &|_| {}, &cancel).unwrap();
     assert!(passes.is_empty());
+}
+
+/// A cancel seen inside the last block of a range's pass (a 4x4 image is one block) leaves that
+/// pass out: a range never holds a partial pass, which a distributed render would add to its film.
+#[test]
+fn a_range_cancelled_inside_its_last_block_returns_no_partial_pass() {
+    let (world, camera) = cornell(4, 4);
+    let mut options = RenderOptions::new(Technique::ambient_occlusion(1 << 30));
+    options.spp = 2;
+    let cancel = AtomicBool::new(false);
+    let passes = std::thread::scope(|scope| {
+        scope.spawn(|| {
+            std::thread::sleep(std::time::Duration::from_millis(50));
+            cancel.store(true, Ordering::Relaxed);
+        });
+        render_pass_range(&world, &camera, &options, 0, 2, &|_| {}, &cancel).unwrap()
+    });
+    assert!(passes.is_empty(), "{} passes", passes.len());
 }
 
 /// A range as long as a u32 counts asks for no memory up front: one cancelled at once returns
