@@ -191,7 +191,8 @@ impl Material {
     /// 3. **No specular layer** ([`MaterialKind::Lambert`]): `illum` 0 or 1 (the models without
     ///    highlights; 1 is also what a material without `illum` gets), or `Ks` black.
     /// 4. **Smooth specular**: `illum` 3, 5 or 8 (reflection on), or `Ns ≥` [`SMOOTH_NS`]: a
-    ///    [`MaterialKind::Mirror`] of `Ks` when the base colour is black (no `Kd`, no texture),
+    ///    [`MaterialKind::Mirror`] of `Ks` when the base colour is black (`Kd 0`, no texture; a
+    ///    material without `Kd` has the grey of [`Material::default_grey`]),
     ///    otherwise a plastic whose layer is as smooth as GGX goes (`α =` [`MIN_ALPHA`]), so that
     ///    a glossy paint keeps its colour.
     /// 5. **Plastic**: `Kd` under a GGX layer of `Ks`, `α =` [`alpha_from_ns`]`(Ns)`.

@@ -415,6 +415,94 @@ fn values_without_effect_are_named_in_the_material_warning() {
     }
 }
 
+/// 3ds Max names its materials `Material #1`, `Material #2`, ...: a word that starts with `#`
+/// and goes on is part of a name (`newmtl`, `usemtl`, a texture's file), as Blender and
+/// tinyobjloader read it; a `#` standing alone starts a comment. Cut at the `#`, the two
+/// materials were one, `Material`, and `usemtl #1` failed the load.
+#[test]
+fn a_hash_that_starts_a_word_of_a_name_is_part_of_it() {
+    let mtl = "newmtl Material #1\nKd 0 0 1\nnewmtl Material #2 # the yellow one\nKd 1 1 0\n\
+               newmtl #1\nKd 1 0 0\nmap_Kd wood #2.png\n";
+    let obj =
+        format!("mtllib m.mtl\n{SQUARE}usemtl Material #1\nf 1 2 3\nusemtl Material #2\nf 1 3 4\nusemtl #1\nf 2 3 4\n");
+    let scene = parse_with(&obj, &[("m.mtl", mtl)]);
+    assert!(scene.warnings.is_empty(), "{:#?}", scene.warnings);
+    let names: Vec<&str> = (0..3).map(|t| material_of(&scene, t).name.as_str()).collect();
+    assert_eq!(names, ["Material #1", "Material #2", "#1"]);
+    assert_eq!([0, 1, 2].map(|t| material_of(&scene, t).kd), [Vec3::Z, Vec3::new(1.0, 1.0, 0.0), Vec3::X]);
+    assert_eq!(material_of(&scene, 2).map_kd.as_deref(), Some(Path::new("mem/wood #2.png")));
+}
+
+/// `d` wins over `Tr` whichever comes first, as tinyobjloader reads them (3ds Max writes both);
+/// `Tr` alone is `1 - d`, and the warning about its coverage names `Tr`, what the file wrote.
+/// `d 1` then `Tr 1` made an opaque material glass.
+#[test]
+fn d_wins_over_tr_in_either_order() {
+    let mtl = "newmtl d_first\nNi 1.5\nd 1\nTr 1\nnewmtl tr_first\nNi 1.5\nTr 1\nd 1\n\
+               newmtl tr_only\nTr 0.25\n";
+    let scene = parse_with(&format!("mtllib m.mtl\n{SQUARE}f 1 2 3\n"), &[("m.mtl", mtl)]);
+    // The faces come before any `usemtl`: the fourth material is the default one.
+    let [d_first, tr_first, tr_only, _] = &scene.materials[..] else { panic!("{:?}", scene.materials) };
+    assert_eq!((d_first.dissolve, tr_first.dissolve, tr_only.dissolve), (1.0, 1.0, 0.75));
+    for opaque in [d_first, tr_first] {
+        assert!(!matches!(opaque.kind(), lumiere::materials::MaterialKind::Dielectric { .. }), "{opaque:?}");
+    }
+    assert_eq!(scene.warnings.len(), 1, "{:#?}", scene.warnings);
+    assert!(
+        scene.warnings[0].contains("material \"tr_only\" uses statements lumiere does not render: \"Tr\" above 0"),
+        "{}",
+        scene.warnings[0]
+    );
+}
+
+/// A `newmtl` without a name starts a material no `usemtl` can name: its statements are not
+/// read, where they overwrote the material before it (red turned green).
+#[test]
+fn the_statements_of_a_nameless_newmtl_leave_the_material_before_it_alone() {
+    let mtl = "newmtl red\nKd 1 0 0\nnewmtl\nKd 0 1 0\nTf 0 0 1\nnewmtl blue\nKd 0 0 1\n";
+    let scene = parse_with(&format!("mtllib m.mtl\n{SQUARE}usemtl red\nf 1 2 3\n"), &[("m.mtl", mtl)]);
+    let kds: Vec<Vec3> = scene.materials.iter().map(|m| m.kd).collect();
+    assert_eq!(kds, [Vec3::X, Vec3::Z]);
+    assert_eq!(scene.materials[0].tf, Vec3::ONE);
+    assert_eq!(scene.warnings.len(), 1, "{:#?}", scene.warnings);
+    assert!(
+        scene.warnings[0]
+            .contains("m.mtl:3: newmtl without a name: its statements, up to the next newmtl, are not read"),
+        "{}",
+        scene.warnings[0]
+    );
+}
+
+/// Some exporters write the illumination model as a float (`illum 2.0`); Blender and
+/// tinyobjloader read its whole part. It was refused, and the glossy material became Lambertian.
+/// What is not a number, negative or past `u32` is still refused.
+#[test]
+fn an_illumination_model_written_with_a_fraction_is_read_as_its_whole_part() {
+    let mtl = "newmtl a\nillum 2.0\nnewmtl b\nillum 7.9\nnewmtl c\nillum 3\nillum -1\nillum 1e10\nillum two\n";
+    let scene = parse_with(&format!("mtllib m.mtl\n{SQUARE}f 1 2 3\n"), &[("m.mtl", mtl)]);
+    let illums: Vec<u32> = scene.materials[..3].iter().map(|m| m.illum).collect();
+    assert_eq!(illums, [2, 7, 3]);
+    assert_eq!(scene.warnings.len(), 3, "{:#?}", scene.warnings);
+    for (warning, value) in scene.warnings.iter().zip(["-1", "1e10", "two"]) {
+        assert!(warning.contains(&format!("malformed illumination model \"{value}\"")), "{warning}");
+    }
+}
+
+/// The MTL specification's other colour forms, CIE XYZ and a spectral file, are named as what
+/// they are, not as a malformed number.
+#[test]
+fn xyz_and_spectral_colours_are_named_as_unsupported_forms() {
+    let mtl = "newmtl a\nKd xyz 0.5 0.5 0.5\nTf spectral glass.rfl 1.0\n";
+    let scene = parse_with(&format!("mtllib m.mtl\n{SQUARE}f 1 2 3\n"), &[("m.mtl", mtl)]);
+    assert_eq!(scene.warnings.len(), 2, "{:#?}", scene.warnings);
+    for (warning, form) in scene.warnings.iter().zip(["xyz", "spectral"]) {
+        assert!(
+            warning.contains(&format!("the \"{form}\" form of a colour is not supported (only r g b)")),
+            "{warning}"
+        );
+    }
+}
+
 #[test]
 fn mtllib_with_several_files_or_a_name_with_spaces() {
     let a = "newmtl a\nKd 1 0 0\n";

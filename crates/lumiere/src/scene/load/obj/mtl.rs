@@ -49,27 +49,35 @@ pub(super) fn parse_mtl(bytes: &[u8], path: &Path, warnings: &mut Warnings) -> V
     };
     let bytes = joined.as_deref().unwrap_or(bytes);
     let mut materials: Vec<Material> = Vec::new();
-    // Per material, what it carries that lumiere does not render: unknown statements' keywords
-    // (quoted) and texture options.
-    let mut unsupported: Vec<Vec<String>> = Vec::new();
+    let mut notes: Vec<Notes> = Vec::new();
+    // After a `newmtl` without a name, whose statements belong to no material we could name.
+    let mut nameless = false;
     for (i, line) in lines(bytes).enumerate() {
         let problem = match parse_statement(line, folder) {
             Ok(None) => continue,
             Ok(Some(Statement::NewMtl(name))) => {
                 materials.push(Material::default_grey(&name));
-                unsupported.push(Vec::new());
+                notes.push(Notes::default());
+                nameless = false;
                 continue;
             }
+            Ok(Some(Statement::NamelessMtl)) => {
+                // Applied to the material before it, they would overwrite its values. Readers
+                // drop them too: tinyobjloader keeps no material of an empty name.
+                nameless = true;
+                "newmtl without a name: its statements, up to the next newmtl, are not read".to_string()
+            }
+            Ok(Some(_)) if nameless => continue,
             Ok(Some(Statement::Unsupported(keyword))) if !materials.is_empty() => {
-                note(&mut unsupported, quote(&keyword));
+                note(&mut notes, quote(&keyword));
                 continue;
             }
-            Ok(Some(statement)) => match materials.last_mut() {
-                Some(material) => {
+            Ok(Some(statement)) => match (materials.last_mut(), notes.last_mut()) {
+                (Some(material), Some(material_notes)) => {
                     for option in statement.texture_options() {
-                        note(&mut unsupported, option);
+                        push_once(&mut material_notes.unsupported, option);
                     }
-                    statement.apply(material);
+                    statement.apply(material, material_notes);
                     if let Some(clamped) = material.clamp_kd() {
                         warnings.push(path, "clamped colours", || {
                             format!("{}:{}: material {}: {clamped}", shown_path(path), i + 1, quote(&material.name))
@@ -77,14 +85,15 @@ pub(super) fn parse_mtl(bytes: &[u8], path: &Path, warnings: &mut Warnings) -> V
                     }
                     continue;
                 }
-                None => "statement before the first newmtl".to_string(),
+                _ => "statement before the first newmtl".to_string(),
             },
             Err(message) => message,
         };
         warnings.push(path, "ignored MTL lines", || format!("{}:{}: {problem}; line ignored", shown_path(path), i + 1));
     }
-    for (material, ignored) in materials.iter().zip(&mut unsupported) {
-        ignored.extend(unrendered_values(material));
+    for (material, notes) in materials.iter().zip(notes) {
+        let mut ignored = notes.unsupported;
+        ignored.extend(unrendered_values(material, notes.coverage_from_tr));
         if ignored.is_empty() {
             continue;
         }
@@ -100,25 +109,41 @@ pub(super) fn parse_mtl(bytes: &[u8], path: &Path, warnings: &mut Warnings) -> V
     materials
 }
 
+/// What parsing learns of a material besides its values.
+#[derive(Default)]
+struct Notes {
+    /// What it carries that lumiere does not render: unknown statements' keywords (quoted) and
+    /// texture options, each once.
+    unsupported: Vec<String>,
+    /// Whether a `d` statement set its coverage: a `Tr` then changes nothing, before or after it.
+    has_d: bool,
+    /// Whether its coverage came from `Tr` (no `d`), for the warning to name what the file wrote.
+    coverage_from_tr: bool,
+}
+
 /// Adds `what` to the current material's list of what it does not get, once.
-fn note(unsupported: &mut [Vec<String>], what: String) {
-    let ignored = unsupported.last_mut().expect("one list per material");
-    if !ignored.contains(&what) {
-        ignored.push(what);
+fn note(notes: &mut [Notes], what: String) {
+    push_once(&mut notes.last_mut().expect("notes for each material").unsupported, what);
+}
+
+fn push_once(list: &mut Vec<String>, what: String) {
+    if !list.contains(&what) {
+        list.push(what);
     }
 }
 
 /// Statements lumiere reads but whose value, on this material, has no effect (docs/MATERIALS.md,
 /// "Not honoured"): a transmission filter on an opaque material, partial coverage without a
-/// texture, an illumination model beyond 9.
-fn unrendered_values(material: &Material) -> Vec<String> {
+/// texture (given as `Tr` if `coverage_from_tr`), an illumination model beyond 9.
+fn unrendered_values(material: &Material, coverage_from_tr: bool) -> Vec<String> {
     let glass = matches!(material.kind(), MaterialKind::Dielectric { .. });
     let mut notes = Vec::new();
     if !glass && material.tf != Vec3::ONE {
         notes.push("\"Tf\" (only glass filters light)".to_string());
     }
     if !glass && material.dissolve < 1.0 && material.map_d.is_none() {
-        notes.push("\"d\" below 1 without \"Ni\" (partial coverage: use map_d for cutouts)".to_string());
+        let coverage = if coverage_from_tr { "\"Tr\" above 0" } else { "\"d\" below 1" };
+        notes.push(format!("{coverage} without \"Ni\" (partial coverage: use map_d for cutouts)"));
     }
     if material.illum > 9 {
         notes.push(quote(format!("illum {}", material.illum)));
@@ -129,12 +154,16 @@ fn unrendered_values(material: &Material) -> Vec<String> {
 /// The MTL statements we keep; the others are named in one warning per material (`Ka` aside).
 enum Statement {
     NewMtl(String),
+    /// A `newmtl` without a name.
+    NamelessMtl,
     Diffuse(Vec3),
     Specular(Vec3),
     Emission(Vec3),
     Shininess(f32),
     RefractiveIndex(f32),
     Dissolve(f32),
+    /// `Tr`, transparency: coverage `1 - Tr` where the material has no `d`.
+    Transparency(f32),
     Illumination(u32),
     DiffuseMap(TextureMap),
     CoverageMap(TextureMap),
@@ -157,15 +186,23 @@ impl Statement {
         options.iter().map(|option| quote(format!("{keyword} {option}"))).collect()
     }
 
-    fn apply(self, material: &mut Material) {
+    fn apply(self, material: &mut Material, notes: &mut Notes) {
         match self {
-            Statement::NewMtl(name) => material.name = name,
             Statement::Diffuse(kd) => material.kd = kd,
             Statement::Specular(ks) => material.ks = ks,
             Statement::Emission(ke) => material.ke = ke,
             Statement::Shininess(ns) => material.ns = ns,
             Statement::RefractiveIndex(ni) => material.ni = ni,
-            Statement::Dissolve(d) => material.dissolve = d,
+            // `d` wins over `Tr` whatever their order, as tinyobjloader reads them: 3ds Max writes
+            // both, with a `Tr` that some versions meant as `d` itself.
+            Statement::Dissolve(d) => {
+                material.dissolve = d;
+                (notes.has_d, notes.coverage_from_tr) = (true, false);
+            }
+            Statement::Transparency(tr) if !notes.has_d => {
+                material.dissolve = 1.0 - tr;
+                notes.coverage_from_tr = true;
+            }
             Statement::Illumination(illum) => material.illum = illum,
             Statement::DiffuseMap(map) => {
                 (material.map_kd, material.map_kd_transform) = (Some(map.path), map.transform)
@@ -174,7 +211,7 @@ impl Statement {
             Statement::TransmissionFilter(tf) => material.tf = tf,
             Statement::Metallic(pm) => material.metallic = Some(pm),
             Statement::Roughness(pr) => material.roughness = Some(pr),
-            Statement::Unsupported(_) => {}
+            Statement::NewMtl(_) | Statement::NamelessMtl | Statement::Transparency(_) | Statement::Unsupported(_) => {}
         }
     }
 }
@@ -189,7 +226,7 @@ fn parse_statement(line: &[u8], folder: &Path) -> Result<Option<Statement>, Stri
         return Ok(None);
     };
     let statement = match keyword {
-        b"newmtl" => Statement::NewMtl(material_name(tokens)?),
+        b"newmtl" => material_name(tokens).map_or(Statement::NamelessMtl, Statement::NewMtl),
         b"Kd" => Statement::Diffuse(color(tokens)?),
         b"Ks" => Statement::Specular(color(tokens)?),
         b"Ke" => Statement::Emission(emission(tokens)?),
@@ -197,8 +234,8 @@ fn parse_statement(line: &[u8], folder: &Path) -> Result<Option<Statement>, Stri
         b"Ni" => Statement::RefractiveIndex(scalar(tokens)?),
         // `d -halo 0.5` is an old variant; the halo itself is ignored.
         b"d" => Statement::Dissolve(scalar(tokens.skip_while(|&token| token == b"-halo"))?),
-        b"Tr" => Statement::Dissolve(1.0 - scalar(tokens)?),
-        b"illum" => Statement::Illumination(integer(tokens)?),
+        b"Tr" => Statement::Transparency(scalar(tokens)?),
+        b"illum" => Statement::Illumination(illumination(tokens)?),
         b"map_Kd" => Statement::DiffuseMap(texture_map("map_Kd", tokens, folder)?),
         b"map_d" => Statement::CoverageMap(texture_map("map_d", tokens, folder)?),
         b"Tf" => Statement::TransmissionFilter(color(tokens)?),
@@ -211,16 +248,18 @@ fn parse_statement(line: &[u8], folder: &Path) -> Result<Option<Statement>, Stri
     Ok(Some(statement))
 }
 
-fn material_name(tokens: Tokens) -> Result<String, String> {
+fn material_name(tokens: Tokens) -> Option<String> {
     let name = tokens.remainder();
-    if name.is_empty() {
-        return Err("newmtl without a name".to_string());
-    }
-    Ok(name.into_owned())
+    (!name.is_empty()).then(|| name.into_owned())
 }
 
-/// `r g b`, or a single value for grey, as the MTL format allows.
-fn color<'a>(tokens: impl Iterator<Item = &'a [u8]>) -> Result<Vec3, String> {
+/// `r g b`, or a single value for grey, as the MTL format allows. Its other two forms, a CIE XYZ
+/// colour (`xyz x y z`) and a spectral curve from a file (`spectral file.rfl`), are named in the
+/// warning: a reader meets them rarely enough that "malformed number" would mislead.
+fn color(tokens: Tokens) -> Result<Vec3, String> {
+    if let Some(form @ (b"xyz" | b"spectral")) = tokens.clone().next() {
+        return Err(format!("the {} form of a colour is not supported (only r g b)", quote(form)));
+    }
     let values = tokens.map(finite_f32).collect::<Result<Vec<_>, _>>()?;
     match values[..] {
         [grey] => Ok(Vec3::splat(grey)),
@@ -231,7 +270,7 @@ fn color<'a>(tokens: impl Iterator<Item = &'a [u8]>) -> Result<Vec3, String> {
 
 /// An emitted radiance: a colour none of whose components is negative (light cannot be taken
 /// away; a negative weight would also leave the scene without power-proportional light choice).
-fn emission<'a>(tokens: impl Iterator<Item = &'a [u8]>) -> Result<Vec3, String> {
+fn emission(tokens: Tokens) -> Result<Vec3, String> {
     let ke = color(tokens)?;
     if ke.min_element() < 0.0 {
         return Err(format!("Ke must not be negative, found {} {} {}", ke.x, ke.y, ke.z));
@@ -246,13 +285,19 @@ fn scalar<'a>(mut tokens: impl Iterator<Item = &'a [u8]>) -> Result<f32, String>
     }
 }
 
-fn integer<'a>(mut tokens: impl Iterator<Item = &'a [u8]>) -> Result<u32, String> {
+/// An illumination model: a whole number, or a number written with a fraction (`illum 2.0`),
+/// which some exporters write and readers cut to its whole part (Blender: "some MTL files
+/// incorrectly use a float for this value"; tinyobjloader reads it with `atoi`).
+fn illumination<'a>(mut tokens: impl Iterator<Item = &'a [u8]>) -> Result<u32, String> {
     match (tokens.next(), tokens.next()) {
-        (Some(token), None) => std::str::from_utf8(token)
-            .ok()
-            .and_then(|text| text.parse().ok())
-            .ok_or_else(|| format!("malformed integer {}", quote(token))),
-        _ => Err("expected exactly one integer".to_string()),
+        (Some(token), None) => {
+            let text = std::str::from_utf8(token).ok();
+            let whole = text.and_then(|text| text.parse().ok());
+            // `as` saturates, so the range test is on the float.
+            let cut = || text?.parse::<f32>().ok().filter(|x| (0.0..=u32::MAX as f32).contains(x)).map(|x| x as u32);
+            whole.or_else(cut).ok_or_else(|| format!("malformed illumination model {}", quote(token)))
+        }
+        _ => Err("expected exactly one number".to_string()),
     }
 }
 

@@ -40,11 +40,12 @@ impl<'a> Tokens<'a> {
         Tokens { rest: line }
     }
 
-    /// What is left of the line, trimmed and without a trailing comment, as its bytes: file names
-    /// keep them, so that a name in the file's own encoding finds its file.
+    /// What is left of the line, trimmed and without a trailing comment (see
+    /// [`name_comment_start`]), as its bytes: file names keep them, so that a name in the file's
+    /// own encoding finds its file.
     pub(super) fn remainder_bytes(self) -> &'a [u8] {
         let rest = self.rest.trim_ascii_start();
-        rest[..comment_start(rest).unwrap_or(rest.len())].trim_ascii_end()
+        rest[..name_comment_start(rest).unwrap_or(rest.len())].trim_ascii_end()
     }
 
     /// What is left of the line, trimmed, as one name (see [`text`]): material and file names may
@@ -57,6 +58,17 @@ impl<'a> Tokens<'a> {
 /// Where a comment starts in `line`: at a `#` that begins a token (`Material#1` keeps its `#`).
 pub(super) fn comment_start(line: &[u8]) -> Option<usize> {
     line.iter().enumerate().position(|(i, &b)| b == b'#' && (i == 0 || line[i - 1].is_ascii_whitespace()))
+}
+
+/// Where a comment starts after a name (`newmtl`, `usemtl`, `mtllib`, a texture's file): at a `#`
+/// that stands alone as a word (`glass # the chandelier`). A word that starts with `#` and goes on
+/// is part of the name: 3ds Max names its materials `Material #1`, `Material #2`, ..., which
+/// Blender's and tinyobjloader's readers keep whole, where cutting at the `#` made them all one
+/// material, `Material`.
+fn name_comment_start(name: &[u8]) -> Option<usize> {
+    let starts_word = |i: usize| i == 0 || name[i - 1].is_ascii_whitespace();
+    let ends_word = |i: usize| name.get(i + 1).is_none_or(u8::is_ascii_whitespace);
+    (0..name.len()).find(|&i| name[i] == b'#' && starts_word(i) && ends_word(i))
 }
 
 /// A name as text: UTF-8 where it is valid, otherwise each byte read as Latin-1, as older
