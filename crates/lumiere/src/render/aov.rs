@@ -28,8 +28,9 @@ pub enum Aov {
     Albedo,
     /// The shading normal of the first hit in world space, facing the camera; zero where rays escape.
     Normal,
-    /// The distance along the camera ray to the first hit (in `x`; `y` and `z` copy it); 0 where
-    /// rays escape.
+    /// The distance along the camera ray to the first hit (in `x`; `y` and `z` copy it), averaged
+    /// over the samples that hit: a pixel on a silhouette has its surface's depth, not a fraction
+    /// of it. 0 where every ray escapes.
     Depth,
 }
 
@@ -76,7 +77,7 @@ pub fn render_aovs(
             }
             (0..width)
                 .map(|x| {
-                    let mut sum = [Vec3::ZERO; 3];
+                    let (mut sum, mut hits) = ([Vec3::ZERO; 3], 0u32);
                     for sample in 0..samples {
                         let (ray, _) = camera_sample(camera, &sampler, (x, y), sample, centre);
                         let Some(hit) = world.intersect(&ray) else { continue };
@@ -84,8 +85,12 @@ pub fn render_aovs(
                         sum[0] += world.bsdf(&surface).albedo();
                         sum[1] += surface.ns;
                         sum[2] += Vec3::splat(hit.t * ray.dir.length());
+                        hits += 1;
                     }
-                    sum.map(|s| s / samples as f32)
+                    // Albedo and normal are covered fractions (what a denoiser expects of an edge);
+                    // a depth is a distance, which escaping rays have none of.
+                    let [albedo, normal, depth] = sum;
+                    [albedo / samples as f32, normal / samples as f32, depth / hits.max(1) as f32]
                 })
                 .collect()
         })

@@ -6,9 +6,11 @@ use std::sync::atomic::AtomicBool;
 use glam::Vec3;
 use lumiere::integrators::Technique;
 use lumiere::materials::Bsdf;
+use lumiere::materials::Material;
 use lumiere::render::RenderOptions;
 use lumiere::render::aov::{Aov, render_aovs};
 use lumiere::scene::camera::Camera;
+use lumiere::scene::mesh::TriangleMesh;
 use lumiere::scene::{Scene, builtin};
 use lumiere::world::World;
 
@@ -56,4 +58,33 @@ fn aovs_average_the_first_hits_of_the_pixel_samples() {
     let reordered =
         render_aovs(&world, &camera, &options, &[Aov::Normal, Aov::Depth], &AtomicBool::new(false)).unwrap();
     assert_eq!(reordered, [aovs[2].clone(), aovs[0].clone()], "buffers come in the order asked");
+}
+
+/// A square facing the camera at distance 5, which the image's middle column of pixels straddles
+/// (the square's edge runs through their centres): every depth is 0 (no sample hits) or the
+/// square's distance, 5 on the axis and less than 5 / cos²(5°) at the corners (the field of view
+/// is 10°). The depth was the mean over all samples, misses as 0: about 2.5 on that column, no
+/// surface's distance.
+#[test]
+fn the_depth_of_a_pixel_on_a_silhouette_is_its_surfaces() {
+    let corners =
+        [Vec3::new(-9.0, -9.0, 0.0), Vec3::new(0.0, -9.0, 0.0), Vec3::new(0.0, 9.0, 0.0), Vec3::new(-9.0, 9.0, 0.0)];
+    let mesh = TriangleMesh {
+        positions: corners.to_vec(),
+        indices: vec![[0, 1, 2], [0, 2, 3]],
+        material_ids: vec![0, 0],
+        ..Default::default()
+    };
+    let scene = Scene::from_parts("edge".into(), mesh, vec![Material::default_grey("grey")], vec![]).unwrap();
+    let world = World::new(scene, Default::default());
+    let camera = Camera::look_at(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, 10.0, 9, 9).unwrap();
+    let options = RenderOptions { spp: 16, ..RenderOptions::new(Technique::direct(1)) };
+    let aovs = render_aovs(&world, &camera, &options, &[Aov::Depth], &AtomicBool::new(false)).unwrap();
+    // Rounding may put the axis a few ulps short of 5.
+    let (nearest, farthest) = (5.0 * (1.0 - 1e-5), 5.0 / (5f32.to_radians()).cos().powi(2));
+    for (pixel, depth) in aovs[0].iter().enumerate() {
+        assert!(depth.x == 0.0 || (nearest..=farthest).contains(&depth.x), "pixel {pixel}: depth {}", depth.x);
+    }
+    let middle_column: Vec<f32> = (0..9).map(|y| aovs[0][y * 9 + 4].x).collect();
+    assert!(middle_column.iter().all(|&d| d >= nearest), "the edge's pixels: {middle_column:?}");
 }
