@@ -104,6 +104,129 @@ fn polygons_split_as_fans_in_file_order() {
     assert_eq!(scene.mesh.indices, expected);
 }
 
+/// An L-shaped hexagon, counter-clockwise seen from +z, with its corners' texture coordinates
+/// and normals numbered as their positions, so that a corner's three indices can be told apart
+/// from another corner's.
+const L_SHAPE: &str = "v 2 0 0\nv 2 1 0\nv 1 1 0\nv 1 2 0\nv 0 2 0\nv 0 0 0\n\
+                       vt 0 0\nvt 0 0\nvt 0 0\nvt 0 0\nvt 0 0\nvt 0 0\n\
+                       vn 0 0 1\nvn 0 0 1\nvn 0 0 1\nvn 0 0 1\nvn 0 0 1\nvn 0 0 1\n";
+
+/// The position of corner `c` of triangle `t`.
+fn corner_of(scene: &ObjScene, t: usize, c: usize) -> Vec3 {
+    scene.mesh.positions[scene.mesh.indices[t][c] as usize]
+}
+
+/// A concave face is ear-clipped, as tinyobjloader splits it, where its fan `(1,2,3), (1,3,4),
+/// ...` laid a triangle over the L's notch (the fan's areas summed to 4 over an L of area 3). Each
+/// corner keeps its own texture coordinate and normal, the winding is the face's, the count is
+/// n - 2, and the faces after it keep their ids.
+#[test]
+fn a_concave_face_is_ear_clipped_and_keeps_its_winding_and_corners() {
+    let text = format!("{L_SHAPE}f 1/1/1 2/2/2 3/3/3 4/4/4 5/5/5 6/6/6\nf 1 2 5\n");
+    let scene = parse(&text);
+    assert_eq!(scene.mesh.triangle_count(), 5);
+    let mut area = 0.0;
+    for t in 0..4 {
+        let [a, b, c] = [0, 1, 2].map(|k| corner_of(&scene, t, k));
+        let normal = (b - a).cross(c - a);
+        assert!(normal.z > 0.0 && normal.x == 0.0 && normal.y == 0.0, "triangle {t} winds as the face: {normal}");
+        area += normal.z / 2.0;
+        let centroid = (a + b + c) / 3.0;
+        assert!(centroid.x < 1.0 || centroid.y < 1.0, "triangle {t} lies in the notch: {centroid}");
+        for list in [&scene.mesh.texcoord_indices, &scene.mesh.normal_indices] {
+            assert_eq!(list[t], scene.mesh.indices[t], "triangle {t}'s corners keep their attributes");
+        }
+    }
+    assert_eq!(area, 3.0);
+    assert_eq!(scene.mesh.indices[4], [0, 1, 4], "the next face keeps its id");
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    // Split in chunks of any size, the file gives the same triangles.
+    for chunk in [1, 20, 64] {
+        let chunked =
+            parse_obj_with_chunk_size(text.as_bytes(), Path::new("test.obj"), &mtl_files(&[]), chunk).unwrap();
+        assert_eq!(chunked.mesh.indices, scene.mesh.indices, "chunks of {chunk} bytes");
+        assert_eq!(chunked.mesh.texcoord_indices, scene.mesh.texcoord_indices, "chunks of {chunk} bytes");
+    }
+}
+
+/// Ear clipping's work grows as the cube of a face's corners: a file of thousands of concave
+/// faces of 64 corners (a comb, here the same one 20,000 times) must not take minutes. The file's
+/// budget clips the first faces and leaves the rest as fans, with a warning.
+#[test]
+fn a_file_of_many_large_concave_faces_is_split_within_a_budget() {
+    // A comb: the bottom edge, then 62 teeth corners from right to left, alternately high and low.
+    let mut text = "v 0 0 0\nv 31 0 0\n".to_string();
+    for k in 0..62 {
+        text += &format!("v {} {} 0\n", 31.0 * (1.0 - k as f32 / 61.0), if k % 2 == 0 { 2 } else { 1 });
+    }
+    let face = format!("f {}\n", (1..=64).map(|k| k.to_string()).collect::<Vec<_>>().join(" "));
+    text += &face.repeat(20_000);
+    let start = Instant::now();
+    let scene = parse(&text);
+    assert!(start.elapsed().as_secs_f64() < 10.0, "{:?}", start.elapsed());
+    assert_eq!(scene.mesh.triangle_count(), 20_000 * 62);
+    let fan: Vec<[u32; 3]> = (1..63).map(|k| [0, k, k + 1]).collect();
+    assert_ne!(scene.mesh.indices[..62], fan[..], "the first face is clipped");
+    assert_eq!(scene.mesh.indices[62 * 19_999..], fan[..], "the last one is left a fan");
+    assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
+    assert!(scene.warnings[0].contains("concave face(s) keep their fan of triangles"), "{}", scene.warnings[0]);
+}
+
+/// Random star-shaped faces (corners at random radii about a centre, in order of angle), concave
+/// most of the time: their ear clipping covers each exactly, its triangles summing to the face's
+/// area (the shoelace formula) and none of them turned over.
+#[test]
+fn ear_clipping_covers_random_star_shaped_faces_exactly() {
+    let mut rng = crate::common::TestRng(11);
+    for case in 0..200 {
+        let n = 4 + rng.below(61);
+        let corners: Vec<Vec2> = (0..n)
+            .map(|k| {
+                let angle = (k as f32 + rng.range(0.1, 0.9)) * std::f32::consts::TAU / n as f32;
+                rng.range(0.2, 1.0) * Vec2::new(angle.cos(), angle.sin())
+            })
+            .collect();
+        let mut text: String = corners.iter().map(|c| format!("v {} {} 0\n", c.x, c.y)).collect();
+        text += &format!("f {}\n", (1..=n).map(|k| k.to_string()).collect::<Vec<_>>().join(" "));
+        let scene = parse(&text);
+        let shoelace: f64 = (0..n).map(|k| f64::from(corners[k].perp_dot(corners[(k + 1) % n]))).sum::<f64>() / 2.0;
+        let mut area = 0.0;
+        for t in 0..n - 2 {
+            let [a, b, c] = [0, 1, 2].map(|k| corner_of(&scene, t, k).truncate().as_dvec2());
+            let twice = (b - a).perp_dot(c - a);
+            assert!(twice >= -1e-9, "case {case}: triangle {t} is turned over ({twice})");
+            area += twice / 2.0;
+        }
+        assert!((area - shoelace).abs() < 1e-5 * shoelace, "case {case}, {n} corners: {area} where {shoelace}");
+    }
+}
+
+/// A star of 66 corners is concave, and past the 64 corners ear clipping is given (its work
+/// grows as the cube of the corners): it keeps its fan, and one warning says so. A convex face
+/// of as many corners keeps its fan without a word.
+#[test]
+fn a_concave_face_of_too_many_corners_keeps_its_fan_with_a_warning() {
+    let polygon = |radius: &dyn Fn(usize) -> f32| {
+        let mut text = String::new();
+        for k in 0..66 {
+            let angle = k as f32 * std::f32::consts::TAU / 66.0;
+            text += &format!("v {} {} 0\n", radius(k) * angle.cos(), radius(k) * angle.sin());
+        }
+        text + "f " + &(1..=66).map(|k| k.to_string()).collect::<Vec<_>>().join(" ") + "\n"
+    };
+    let fan: Vec<[u32; 3]> = (1..65).map(|k| [0, k, k + 1]).collect();
+    let star = parse(&polygon(&|k| if k % 2 == 0 { 1.0 } else { 0.5 }));
+    assert_eq!(star.mesh.indices, fan);
+    assert_eq!(star.warnings.len(), 1, "{:?}", star.warnings);
+    assert!(
+        star.warnings[0].contains("1 concave face(s) of more than 64 corners keep their fan"),
+        "{}",
+        star.warnings[0]
+    );
+    let disc = parse(&polygon(&|_| 1.0));
+    assert_eq!((disc.mesh.indices, disc.warnings.len()), (fan, 0));
+}
+
 #[test]
 fn corner_forms_and_missing_attributes() {
     let text = format!(

@@ -16,6 +16,7 @@ mod chunk;
 mod continued;
 mod materials;
 mod mtl;
+mod polygon;
 mod skipped;
 mod text;
 
@@ -170,13 +171,28 @@ fn parse_obj_within(
     warn_dropped(&mut table, name, texcoords, "texture-coordinate", "texture coordinates", kind);
     warn_dropped(&mut table, name, normals, "normal", "normals", "normal indices out of range");
     skipped.warn(&mut table.warnings, name);
+    let mut mesh = merge(&parsed, material_ids);
+    let unclipped = polygon::clip_concave_faces(&mut mesh, &polygons_in_file(&parsed));
+    let (too_large, out_of_budget) = (unclipped.too_large, unclipped.out_of_budget);
+    if too_large > 0 {
+        table.warnings.push(name, "concave faces too large to split", || {
+            format!(
+                "{}: {too_large} concave face(s) of more than {} corners keep their fan of triangles, which covers them wrongly",
+                shown_path(name),
+                polygon::MAX_CLIPPED_CORNERS
+            )
+        });
+    }
+    if out_of_budget > 0 {
+        table.warnings.push(name, "concave faces past the splitting budget", || {
+            format!(
+                "{}: {out_of_budget} concave face(s) keep their fan of triangles, which covers them wrongly: splitting the file's concave faces took too long",
+                shown_path(name)
+            )
+        });
+    }
     let warnings = std::mem::take(&mut table.warnings).finish();
-    Ok(ObjScene {
-        mesh: merge(&parsed, material_ids),
-        materials: table.materials,
-        warnings,
-        material_files: table.files,
-    })
+    Ok(ObjScene { mesh, materials: table.materials, warnings, material_files: table.files })
 }
 
 /// The text with its continued lines joined (`obj/continued.rs`), in a copy refused up front, as
@@ -261,6 +277,18 @@ fn fill_material(ids: &mut Vec<u32>, end: usize, used: Option<(&str, usize)>, ta
         let id = table.id(used, obj);
         ids.resize(end, id);
     }
+}
+
+/// The faces of more than three corners of every chunk, with their first triangle in the file.
+fn polygons_in_file(chunks: &[ChunkMesh]) -> Vec<polygon::Polygon> {
+    let mut polygons = Vec::with_capacity(chunks.iter().map(|chunk| chunk.polygons.len()).sum());
+    let mut triangles = 0;
+    for chunk in chunks {
+        let offset = |p: &polygon::Polygon| polygon::Polygon { first_triangle: p.first_triangle + triangles, ..*p };
+        polygons.extend(chunk.polygons.iter().map(offset));
+        triangles += chunk.indices.len();
+    }
+    polygons
 }
 
 /// Concatenates the chunks; their indices are already absolute.

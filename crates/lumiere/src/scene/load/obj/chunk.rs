@@ -5,6 +5,7 @@
 //! whole file has. [`parse_chunk`] then turns relative (negative) indices into absolute ones at
 //! once and reports errors with their line number in the file, with no fix-up pass afterwards.
 
+use super::polygon::Polygon;
 use super::skipped::{SkippedKeywords, is_silent};
 use super::text::{Tokens, finite_f32, lines, saturating_i64};
 use crate::error::{Error, Result, quote};
@@ -118,6 +119,9 @@ pub(super) struct ChunkMesh<'a> {
     pub(super) texcoord_indices: Vec<[u32; 3]>,
     /// Empty until the chunk's first corner with a normal, then one entry per triangle.
     pub(super) normal_indices: Vec<[u32; 3]>,
+    /// The faces of more than three corners (their first triangle chunk-local), whose fans are
+    /// checked once the mesh is whole (`polygon.rs`).
+    pub(super) polygons: Vec<Polygon>,
     pub(super) material_switches: Vec<MaterialSwitch<'a>>,
     pub(super) libraries: Vec<MaterialLibrary<'a>>,
     /// Faces with a texture-coordinate index out of range (dropped for those corners).
@@ -240,8 +244,9 @@ impl<'a> ChunkParser<'a> {
     }
 
     /// Splits a polygon into the fan `(a,b,c), (a,c,d), ...` in file order, as gKit does, so that
-    /// triangle ids match its renders.
+    /// triangle ids match its renders (a concave one is split again once the mesh is whole).
     fn face(&mut self, tokens: Tokens, line: usize) -> Result<(), String> {
+        let first_triangle = self.mesh.indices.len();
         let mut first = None;
         let mut previous = None;
         let mut count = 0;
@@ -262,6 +267,9 @@ impl<'a> ChunkParser<'a> {
         }
         if count < 3 {
             return Err(format!("face with {count} corner(s); a face needs at least 3"));
+        }
+        if count > 3 {
+            self.mesh.polygons.push(Polygon { first_triangle, corners: count });
         }
         if texcoord_dropped {
             self.mesh.dropped_texcoords.add(line);
