@@ -687,6 +687,20 @@ fn total_internal_reflection_inside_at_grazing_angles() {
     assert!((weight - glass.tf / (1.0 / 1.5f32).powi(2)).abs().max_element() < 1e-4, "weight {weight}");
 }
 
+/// A `u.x` of exactly 1 (outside the `[0, 1)` the samplers deliver, but what a number remapped
+/// onto `[0, 1]` can round to) still never buys a refraction that Fresnel forbids: at a view so
+/// grazing that `R` is 1 in `f32` and `T` 0, the glass reflects with pdf 1 instead of refracting
+/// with pdf 0 (a sample's pdf is always positive). Only the `T > 0` guard decides this case.
+#[test]
+fn a_dielectric_never_refracts_where_fresnel_transmits_nothing() {
+    let glass = Dielectric::new(DEFAULT_IOR, Vec3::ONE);
+    let wo = Vec3::new(1.0, 0.0, 1e-9);
+    assert_eq!(fresnel_dielectric(wo.z, DEFAULT_IOR), 1.0);
+    let s = glass.sample(wo, Vec2::new(1.0, 0.5)).expect("a reflection");
+    assert!(s.flags.contains(BsdfFlags::REFLECTION | BsdfFlags::SPECULAR), "{s:?}");
+    assert_eq!((s.wi, s.pdf), (mirrored(wo), 1.0));
+}
+
 /// No sample for a `wo` in the surface's plane or not finite, and none carrying an infinite value
 /// where `R / cos θo` overflows `f32` (a view so grazing that Fresnel's `R` rounds to 1): a
 /// specular lobe must never hand the integrator a non-finite weight.

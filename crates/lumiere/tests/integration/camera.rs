@@ -3,7 +3,8 @@
 use std::path::Path;
 
 use glam::{DVec3, Vec3};
-use lumiere::scene::camera::{Camera, Orbiter};
+use lumiere::math::Aabb;
+use lumiere::scene::camera::{Camera, Orbiter, framing};
 
 fn orbiter_2022() -> Orbiter {
     let path = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/cornell/cornell_orbiter.txt"));
@@ -125,5 +126,86 @@ fn rays_at_once_are_the_rays_one_at_a_time() {
                 assert_eq!(rays[lane].tmax.to_bits(), one.tmax.to_bits());
             }
         }
+    }
+}
+
+/// The look-at pinhole's horizontal field follows the picture's shape: at 2:1 with a vertical
+/// field of 45°, the film's right edge is `2 tan 22.5°` across at unit distance and its top
+/// `tan 22.5°` up, so the rays through the middle of the right edge and the top-right corner
+/// point along `(2t, 0, −1)` and `(2t, t, −1)`, `t = tan 22.5°`. (The centre and the top are the
+/// same for any aspect, and the rays test compares `rays` with `ray`, not with a closed form.)
+#[test]
+fn a_look_at_cameras_horizontal_field_follows_the_aspect_ratio() {
+    let camera = Camera::look_at(Vec3::new(0.0, 1.0, 3.9), Vec3::new(0.0, 1.0, 0.0), Vec3::Y, 45.0, 200, 100).unwrap();
+    let t = 22.5f32.to_radians().tan();
+    for ((x, y), expected) in
+        [((200.0, 50.0), Vec3::new(2.0 * t, 0.0, -1.0)), ((200.0, 0.0), Vec3::new(2.0 * t, t, -1.0))]
+    {
+        let ray = camera.ray(x, y);
+        assert!(
+            (ray.dir - expected.normalize()).length() < 1e-6,
+            "({x}, {y}): {} vs {}",
+            ray.dir,
+            expected.normalize()
+        );
+        assert_eq!(ray.origin, Vec3::new(0.0, 1.0, 3.9));
+    }
+}
+
+/// `framing` backs away along +z until the bounds' bounding sphere fills the vertical field of
+/// view: the sphere of radius `r` is tangent to the field's edges at the distance `r / sin(fov/2)`
+/// from its centre. Bounds `(−1, 0, 2)..(3, 2, 6)`: centre `(1, 1, 4)`, diagonal 6, `r = 3`; at 60°
+/// the distance is `3 / sin 30° = 6`.
+#[test]
+fn framing_fits_the_bounding_sphere_into_the_field_of_view() {
+    let bounds = Aabb::from_points(&[Vec3::new(-1.0, 0.0, 2.0), Vec3::new(3.0, 2.0, 6.0)]);
+    let (eye, target) = framing(&bounds, 60.0).expect("frames");
+    assert_eq!(target, Vec3::new(1.0, 1.0, 4.0));
+    assert!((eye - Vec3::new(1.0, 1.0, 10.0)).length() < 1e-5, "eye {eye}");
+    // A single point has no radius: the eye stands just above it.
+    let (eye, target) = framing(&Aabb::from_points(&[Vec3::new(1.0, 2.0, 3.0)]), 45.0).expect("frames a point");
+    assert!(eye.z > target.z && eye.z - target.z < 2e-6 && eye.truncate() == target.truncate(), "{eye} {target}");
+}
+
+/// What `framing` refuses, each for its documented reason, and where the limits lie: an empty
+/// box; fields of view outside (0, 180); a field so narrow that the eye would stand more than
+/// 65536 radii away (1e-3° puts it at ~115000 radii, 2e-3° at ~57300: accepted); bounds whose
+/// eye or radius overflows `f32`, or so far from the origin that the eye rounds onto the target.
+#[test]
+fn framing_refuses_what_it_cannot_frame_and_says_why() {
+    let bounds = Aabb::from_points(&[Vec3::new(-1.0, 0.0, 2.0), Vec3::new(3.0, 2.0, 6.0)]);
+    assert_eq!(framing(&Aabb::EMPTY, 60.0), Err("no vertices to frame".to_string()));
+    for fov in [0.0, -5.0, 180.0, 200.0, f32::NAN] {
+        let message = framing(&bounds, fov).unwrap_err();
+        assert!(message.contains("must be in (0, 180) degrees"), "fov {fov}: {message}");
+    }
+    assert!(framing(&bounds, 1e-3).unwrap_err().contains("too narrow"));
+    assert!(framing(&bounds, 2e-3).is_ok());
+    let too_large = [
+        // A radius that overflows (the diagonal is beyond f32::MAX).
+        Aabb::from_points(&[Vec3::splat(-3e38), Vec3::splat(3e38)]),
+        // A finite radius, target and distance (2.9e38 at 20°), but the eye beyond f32::MAX.
+        Aabb::from_points(&[Vec3::new(0.0, 0.0, 1e38), Vec3::new(0.0, 0.0, 2e38)]),
+        // A point far from the origin: 1e-6 above it rounds back onto it.
+        Aabb::from_points(&[Vec3::splat(1e8)]),
+    ];
+    for bounds in too_large {
+        let message = framing(&bounds, 20.0).unwrap_err();
+        assert!(message.contains("too large"), "{bounds:?}: {message}");
+    }
+}
+
+/// An orbiter whose numbers are finite but whose camera casts no finite ray is refused at its `s`
+/// line: a radius of 1e39 puts the far plane 1e40 times beyond the near one, and huge numbers
+/// overflow the matrices (the fuzz corpus's `huge-radius.txt` and `huge-finite.txt`).
+#[test]
+fn orbiters_whose_rays_are_not_finite_are_refused() {
+    let path = Path::new("cam.txt");
+    let huge_radius = b"c -0.01 0.995 -0.025\np 0.149664 -0.266665\nr 18 16\ns 2.450631 1e39\n";
+    let huge =
+        b"c 1e308 -1e308 1e308\np 1e308 1e308\nr 1e308 -1e308\ns 1.7976931348623157e308 1.7976931348623157e308\n";
+    for text in [&huge_radius[..], huge] {
+        let message = Orbiter::parse(text, path).unwrap_err().to_string();
+        assert!(message.starts_with("cam.txt:4: the camera's rays are not finite"), "{message}");
     }
 }

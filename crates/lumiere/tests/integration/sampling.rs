@@ -532,6 +532,28 @@ fn samplers_are_decorrelated() {
     }
 }
 
+/// Every (pixel, sample, dimension) draws its own numbers: among 16 pixels × 16 samples × 16
+/// dimensions no 2D point repeats another (48 random bits: a chance repeat among 4096 points is
+/// about 3e-8). A key combined with the address by `|` instead of `^` would give every two
+/// addresses that differ only in bits the key sets the same numbers.
+#[test]
+fn no_two_addresses_draw_the_same_numbers() {
+    for kind in KINDS {
+        for seed in [0, 1, 5, 42] {
+            let sampler = Sampler::new(kind, seed);
+            let mut seen = std::collections::HashMap::new();
+            for (pixel, index, dimension) in
+                (0..16u32).flat_map(|p| (0..16u32).flat_map(move |i| (0..16u32).map(move |d| (p, i, d))))
+            {
+                let v = sampler.get_2d(pixel, index, dimension);
+                if let Some(first) = seen.insert((v.x.to_bits(), v.y.to_bits()), (pixel, index, dimension)) {
+                    panic!("{kind:?}, seed {seed}: {first:?} and {:?} both draw {v}", (pixel, index, dimension));
+                }
+            }
+        }
+    }
+}
+
 #[test]
 fn fast_sin_cos_matches_libm() {
     use lumiere::sampling::warp::sin_cos_turns;
