@@ -43,32 +43,41 @@ pub(super) struct Unclipped {
 /// Replaces the fan of every concave face of `polygons` (whose triangles `mesh` holds as the parser
 /// made them) by an ear clipping of it, in file order; returns what was left unclipped.
 pub(super) fn clip_concave_faces(mesh: &mut TriangleMesh, polygons: &[Polygon]) -> Unclipped {
-    // Told apart in parallel: a mesh of quads has millions of faces, and few are concave.
-    // Each thread reuses one buffer: most faces are quads, tested once, for which an allocation
-    // would cost more than the test.
-    let concave: Vec<Polygon> = polygons
+    // Told apart in parallel (a mesh of quads has millions of faces), as one flag per face: an
+    // indexed collection into one buffer, where collecting the concave faces themselves went
+    // through a list of buffers per task (a third of the pass on a mesh of warped quads). Each
+    // thread reuses one buffer of points: most faces are quads, tested once, for which an
+    // allocation would cost more than the test.
+    let concave: Vec<bool> = polygons
         .par_iter()
         .map_init(Vec::new, |points, polygon| {
             if polygon.corners == 4 {
-                return (!quad_fan_covers(mesh, polygon)).then_some(*polygon);
+                return !quad_fan_covers(mesh, polygon);
             }
             project(mesh, polygon, points);
-            (!is_convex(points)).then_some(*polygon)
+            !is_convex(points)
         })
-        .flatten()
         .collect();
     let mut unclipped = Unclipped::default();
     let mut budget = WORK_BUDGET;
     let (mut points, mut corners) = (Vec::new(), Vec::new());
-    for polygon in &concave {
+    for (polygon, _) in polygons.iter().zip(concave).filter(|&(_, concave)| concave) {
         if polygon.corners > MAX_CLIPPED_CORNERS {
             unclipped.too_large += 1;
             continue;
         }
-        project(mesh, polygon, &mut points);
-        let Some(ears) = ear_clip(&points, &mut budget) else {
-            unclipped.out_of_budget += 1;
-            continue;
+        let clipped;
+        let ears: &[[usize; 3]] = if polygon.corners == 4 {
+            // The other diagonal, 1-3, lies inside where 0-2 does not (see `quad_fan_covers`).
+            &[[0, 1, 3], [1, 2, 3]]
+        } else {
+            project(mesh, polygon, &mut points);
+            let Some(ears) = ear_clip(&points, &mut budget) else {
+                unclipped.out_of_budget += 1;
+                continue;
+            };
+            clipped = ears;
+            &clipped
         };
         let first = polygon.first_triangle;
         for list in [&mut mesh.indices, &mut mesh.texcoord_indices, &mut mesh.normal_indices] {
@@ -78,7 +87,7 @@ pub(super) fn clip_concave_faces(mesh: &mut TriangleMesh, polygons: &[Polygon]) 
             }
             corners.clear();
             corners.extend((0..polygon.corners).map(|k| fan_corner(list, polygon, k)));
-            for (triangle, ear) in list[first..].iter_mut().zip(&ears) {
+            for (triangle, ear) in list[first..].iter_mut().zip(ears) {
                 *triangle = ear.map(|corner| corners[corner]);
             }
         }
