@@ -149,6 +149,39 @@ fn a_concave_face_is_ear_clipped_and_keeps_its_winding_and_corners() {
     }
 }
 
+/// A dart (a quad with one corner turned in) whose fan's diagonal 0-2 runs outside it, its turned
+/// corner at 1 or at 3, is split along 1-3; turned in at 0 or 2, the fan's diagonal is the inside
+/// one and the fan stays. Either way the two triangles cover the dart's area and wind as it does.
+#[test]
+fn a_concave_quad_is_split_along_its_inside_diagonal() {
+    // Counter-clockwise, turned in at (1.5, 0.5); written from each corner in turn.
+    let dart =
+        [Vec3::new(0.0, 0.0, 0.0), Vec3::new(4.0, -1.0, 0.0), Vec3::new(1.5, 0.5, 0.0), Vec3::new(4.0, 2.0, 0.0)];
+    for (turned_in_at, start) in [(2, 0), (1, 1), (0, 2), (3, 3)] {
+        let corners: Vec<Vec3> = (0..4).map(|k| dart[(start + k) % 4]).collect();
+        let mut text: String = corners.iter().map(|c| format!("v {} {} {}\n", c.x, c.y, c.z)).collect();
+        text += "f 1 2 3 4\n";
+        let scene = parse(&text);
+        let mut total = 0.0;
+        for t in 0..2 {
+            let [a, b, c] = [0, 1, 2].map(|k| corner_of(&scene, t, k));
+            let twice = (b - a).cross(c - a).z;
+            assert!(twice > 0.0, "turned in at {turned_in_at}: triangle {t} is turned over");
+            total += twice / 2.0;
+        }
+        let shoelace: f32 =
+            (0..4).map(|k| corners[k].truncate().perp_dot(corners[(k + 1) % 4].truncate())).sum::<f32>() / 2.0;
+        assert!((total - shoelace).abs() < 1e-5, "turned in at {turned_in_at}: {total} where {shoelace}");
+        let fan = vec![[0, 1, 2], [0, 2, 3]];
+        assert_eq!(
+            scene.mesh.indices == fan,
+            turned_in_at % 2 == 0,
+            "turned in at {turned_in_at}: {:?}",
+            scene.mesh.indices
+        );
+    }
+}
+
 /// Ear clipping's work grows as the cube of a face's corners: a file of thousands of concave
 /// faces of 64 corners (a comb, here the same one 20,000 times) must not take minutes. The file's
 /// budget clips the first faces and leaves the rest as fans, with a warning.
