@@ -59,6 +59,12 @@ fn load_shared(relative: &str) -> Option<ObjScene> {
     Some(scene)
 }
 
+/// Asserts that `scene` has exactly one warning, and that it says `needle`.
+fn assert_only_warning(scene: &ObjScene, needle: &str) {
+    assert_eq!(scene.warnings.len(), 1, "{:#?}", scene.warnings);
+    assert!(scene.warnings[0].contains(needle), "{}", scene.warnings[0]);
+}
+
 fn material_of(scene: &ObjScene, triangle: usize) -> &lumiere::materials::Material {
     &scene.materials[scene.mesh.material_ids[triangle] as usize]
 }
@@ -201,8 +207,7 @@ fn a_file_of_many_large_concave_faces_is_split_within_a_budget() {
     let fan: Vec<[u32; 3]> = (1..63).map(|k| [0, k, k + 1]).collect();
     assert_ne!(scene.mesh.indices[..62], fan[..], "the first face is clipped");
     assert_eq!(scene.mesh.indices[62 * 19_999..], fan[..], "the last one is left a fan");
-    assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
-    assert!(scene.warnings[0].contains("concave face(s) keep their fan of triangles"), "{}", scene.warnings[0]);
+    assert_only_warning(&scene, "concave face(s) keep their fan of triangles");
 }
 
 /// Random star-shaped faces (corners at random radii about a centre, in order of angle), concave
@@ -250,12 +255,7 @@ fn a_concave_face_of_too_many_corners_keeps_its_fan_with_a_warning() {
     let fan: Vec<[u32; 3]> = (1..65).map(|k| [0, k, k + 1]).collect();
     let star = parse(&polygon(&|k| if k % 2 == 0 { 1.0 } else { 0.5 }));
     assert_eq!(star.mesh.indices, fan);
-    assert_eq!(star.warnings.len(), 1, "{:?}", star.warnings);
-    assert!(
-        star.warnings[0].contains("1 concave face(s) of more than 64 corners keep their fan"),
-        "{}",
-        star.warnings[0]
-    );
+    assert_only_warning(&star, "1 concave face(s) of more than 64 corners keep their fan");
     let disc = parse(&polygon(&|_| 1.0));
     assert_eq!((disc.mesh.indices, disc.warnings.len()), (fan, 0));
 }
@@ -603,12 +603,7 @@ fn d_wins_over_tr_in_either_order() {
     for opaque in [d_first, tr_first] {
         assert!(!matches!(opaque.kind(), lumiere::materials::MaterialKind::Dielectric { .. }), "{opaque:?}");
     }
-    assert_eq!(scene.warnings.len(), 1, "{:#?}", scene.warnings);
-    assert!(
-        scene.warnings[0].contains("material \"tr_only\" uses statements lumiere does not render: \"Tr\" above 0"),
-        "{}",
-        scene.warnings[0]
-    );
+    assert_only_warning(&scene, "material \"tr_only\" uses statements lumiere does not render: \"Tr\" above 0");
 }
 
 /// A `newmtl` without a name starts a material no `usemtl` can name: its statements are not
@@ -620,13 +615,7 @@ fn the_statements_of_a_nameless_newmtl_leave_the_material_before_it_alone() {
     let kds: Vec<Vec3> = scene.materials.iter().map(|m| m.kd).collect();
     assert_eq!(kds, [Vec3::X, Vec3::Z]);
     assert_eq!(scene.materials[0].tf, Vec3::ONE);
-    assert_eq!(scene.warnings.len(), 1, "{:#?}", scene.warnings);
-    assert!(
-        scene.warnings[0]
-            .contains("m.mtl:3: newmtl without a name: its statements, up to the next newmtl, are not read"),
-        "{}",
-        scene.warnings[0]
-    );
+    assert_only_warning(&scene, "m.mtl:3: newmtl without a name: its statements, up to the next newmtl, are not read");
 }
 
 /// Some exporters write the illumination model as a float (`illum 2.0`); Blender and

@@ -93,7 +93,8 @@ pub(super) fn parse_mtl(bytes: &[u8], path: &Path, warnings: &mut Warnings) -> V
     }
     for (material, notes) in materials.iter().zip(notes) {
         let mut ignored = notes.unsupported;
-        ignored.extend(unrendered_values(material, notes.coverage_from_tr));
+        // Without `d`, a coverage below 1 can only have come from `Tr`.
+        ignored.extend(unrendered_values(material, !notes.has_d));
         if ignored.is_empty() {
             continue;
         }
@@ -117,8 +118,6 @@ struct Notes {
     unsupported: Vec<String>,
     /// Whether a `d` statement set its coverage: a `Tr` then changes nothing, before or after it.
     has_d: bool,
-    /// Whether its coverage came from `Tr` (no `d`), for the warning to name what the file wrote.
-    coverage_from_tr: bool,
 }
 
 /// Adds `what` to the current material's list of what it does not get, once.
@@ -134,7 +133,7 @@ fn push_once(list: &mut Vec<String>, what: String) {
 
 /// Statements lumiere reads but whose value, on this material, has no effect (docs/MATERIALS.md,
 /// "Not honoured"): a transmission filter on an opaque material, partial coverage without a
-/// texture (given as `Tr` if `coverage_from_tr`), an illumination model beyond 9.
+/// texture (named as `Tr` if `coverage_from_tr`), an illumination model beyond 9.
 fn unrendered_values(material: &Material, coverage_from_tr: bool) -> Vec<String> {
     let glass = matches!(material.kind(), MaterialKind::Dielectric { .. });
     let mut notes = Vec::new();
@@ -195,14 +194,8 @@ impl Statement {
             Statement::RefractiveIndex(ni) => material.ni = ni,
             // `d` wins over `Tr` whatever their order, as tinyobjloader reads them: 3ds Max writes
             // both, with a `Tr` that some versions meant as `d` itself.
-            Statement::Dissolve(d) => {
-                material.dissolve = d;
-                (notes.has_d, notes.coverage_from_tr) = (true, false);
-            }
-            Statement::Transparency(tr) if !notes.has_d => {
-                material.dissolve = 1.0 - tr;
-                notes.coverage_from_tr = true;
-            }
+            Statement::Dissolve(d) => (material.dissolve, notes.has_d) = (d, true),
+            Statement::Transparency(tr) if !notes.has_d => material.dissolve = 1.0 - tr,
             Statement::Illumination(illum) => material.illum = illum,
             Statement::DiffuseMap(map) => {
                 (material.map_kd, material.map_kd_transform) = (Some(map.path), map.transform)

@@ -32,7 +32,7 @@ pub(super) const MAX_CLIPPED_CORNERS: usize = 64;
 const WORK_BUDGET: u64 = 50_000_000;
 
 /// The concave faces that keep their fan, by reason.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default)]
 pub(super) struct Unclipped {
     /// More than [`MAX_CLIPPED_CORNERS`] corners.
     pub(super) too_large: usize,
