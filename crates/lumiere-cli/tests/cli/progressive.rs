@@ -181,11 +181,12 @@ fn a_noise_target_out_of_reach_is_said_once() {
     assert!(!text.contains("--noise"), "the time budget ends it first: {text}");
 }
 
-/// SIGINT and SIGTERM: the completed samples are written, the summary says so, exit code 3.
+/// SIGINT, SIGTERM and SIGHUP (a closed terminal or ssh session): the completed samples are
+/// written, the summary says so, exit code 3.
 #[test]
 fn interruption_writes_the_completed_samples_and_exits_3() {
     let dir = TempDir::new("interrupt");
-    for name in ["INT", "TERM"] {
+    for name in ["INT", "TERM", "HUP"] {
         let out = dir.arg(&format!("{name}.png"));
         let stats = dir.arg(&format!("{name}.json"));
         let child = spawn(&[
@@ -213,7 +214,7 @@ fn interruption_writes_the_completed_samples_and_exits_3() {
         assert!(fs::metadata(&out).unwrap().len() > 0);
     }
     let leftovers: Vec<_> = fs::read_dir(&dir.0).unwrap().map(|e| e.unwrap().file_name()).collect();
-    assert_eq!(leftovers.len(), 4, "temporary files left: {leftovers:?}");
+    assert_eq!(leftovers.len(), 6, "temporary files left: {leftovers:?}");
 }
 
 /// SIGKILL at several moments, then resume until done: the same bytes as a render never interrupted.

@@ -30,7 +30,7 @@ use super::args::{ModeArg, RenderArgs, STDOUT_ARG, TonemapArg};
 use super::output;
 use report::Timings;
 
-/// Exit code of a render stopped by SIGINT or SIGTERM (its image of completed samples is written).
+/// Exit code of a render stopped by SIGINT, SIGTERM or SIGHUP (its image of completed samples is written).
 pub const EXIT_INTERRUPTED: u8 = 3;
 
 /// Renders; returns the process exit code (0, or `EXIT_INTERRUPTED`).

@@ -1,8 +1,9 @@
-//! SIGINT and SIGTERM. While the scene loads, nothing is worth saving: a signal exits at once with
-//! code 3. While rendering, the first signal stops the render within a 4x4 block of pixels (the
-//! image of every completed pass and the checkpoint are written, exit code 3); a second one quits
-//! at once, removing any temporary file in flight. Files are written atomically, so no case leaves a
-//! half-written file.
+//! SIGINT, SIGTERM and SIGHUP (ctrlc's `termination` feature: a closed terminal or ssh session
+//! interrupts a render; it does not lose it). While the scene loads, nothing is worth saving: a
+//! signal exits at once with code 3. While rendering, the first signal stops the render within a
+//! 4x4 block of pixels (the image of every completed pass and the checkpoint are written, exit
+//! code 3); a second one quits at once, removing any temporary file in flight. Files are written
+//! atomically, so no case leaves a half-written file.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
