@@ -299,6 +299,65 @@ fn smith_terms_and_reflection_values_match_their_closed_forms() {
     }
 }
 
+/// Each lobe's `eval` and `pdf` against its documented closed form, evaluated in f64 from the
+/// directions alone: Lambert's `kd / π` and `cos θi / π`; the conductor's
+/// `F(ωo·h) D(h) G2 / (4 cos θo cos θi)` with Schlick's `F = F0 + (1 − F0)(1 − ωo·h)⁵`, and
+/// `G1(ωo) D(h) / (4 cos θo)`; the plastic's `ks D G2 / (4 cos θo cos θi) + (1 − max ks) kd / π` and
+/// its mixture pdf. The lobes' samples carry their own `eval` and `pdf` (so the chi-square tests
+/// pass whatever value a lobe returns), the white furnace only bounds the albedo from above, and
+/// `smith_terms_and_reflection_values_match_their_closed_forms` stops at `reflection()`: a
+/// conductor, or either lobe of the plastic, 3% too dark, and Schlick's term with exponent 4
+/// instead of 5, passed every other test.
+#[test]
+fn lobe_values_and_pdfs_match_their_closed_forms() {
+    let mut rng = TestRng(112);
+    let (kd, ks, f0) = (DVec3::new(0.7, 0.5, 0.3), DVec3::new(0.3, 0.2, 0.1), DVec3::new(0.9, 0.6, 0.3));
+    let close = |got: Vec3, expected: DVec3, what: &str| {
+        for c in 0..3 {
+            assert!(
+                (got[c] as f64 - expected[c]).abs() <= 2e-4 * expected[c].abs() + 1e-30,
+                "{what}: channel {c} = {got}, expected {expected}"
+            );
+        }
+    };
+    let lambert = Lambert { reflectance: kd.as_vec3() };
+    for alpha in [0.05f64, 0.3, 0.8] {
+        let a2 = alpha * alpha;
+        let lambda = |w: DVec3| ((1.0 + a2 * (w.x * w.x + w.y * w.y) / (w.z * w.z)).sqrt() - 1.0) / 2.0;
+        let d = |m: DVec3| {
+            let k = m.z * m.z + (m.x * m.x + m.y * m.y) / a2;
+            1.0 / (PI * a2 * k * k)
+        };
+        let conductor = Conductor::new(f0.as_vec3(), alpha as f32);
+        let plastic = Plastic::new(kd.as_vec3(), ks.as_vec3(), alpha as f32);
+        let diffuse = kd * (1.0 - ks.max_element());
+        let specular_probability = ks.element_sum() / (ks.element_sum() + diffuse.element_sum());
+        for _ in 0..5000 {
+            // Above the surface, at least 3° off the horizon (where f32 and f64 part ways).
+            let mut upper = || {
+                let w = rng.direction();
+                Vec3::new(w.x, w.y, w.z.abs().max(0.05)).normalize()
+            };
+            let (wo, wi) = (upper(), upper());
+            let (o, i) = (wo.as_dvec3(), wi.as_dvec3());
+            let h = (o + i).normalize();
+            let mirror = d(h) / ((1.0 + lambda(o) + lambda(i)) * 4.0 * o.z * i.z);
+            let mirror_pdf = d(h) / ((1.0 + lambda(o)) * 4.0 * o.z);
+            let schlick = f0 + (DVec3::ONE - f0) * (1.0 - o.dot(h)).powi(5);
+            let context = format!("α {alpha}, wo {wo}, wi {wi}");
+            close(conductor.eval(wo, wi), schlick * mirror, &format!("conductor f, {context}"));
+            close(Vec3::splat(conductor.pdf(wo, wi)), DVec3::splat(mirror_pdf), &format!("conductor pdf, {context}"));
+            close(plastic.eval(wo, wi), ks * mirror + diffuse / PI, &format!("plastic f, {context}"));
+            let plastic_pdf = specular_probability * mirror_pdf + (1.0 - specular_probability) * i.z / PI;
+            close(Vec3::splat(plastic.pdf(wo, wi)), DVec3::splat(plastic_pdf), &format!("plastic pdf, {context}"));
+            if alpha == 0.3 {
+                close(lambert.eval(wo, wi), kd / PI, &format!("lambert f, {context}"));
+                close(Vec3::splat(lambert.pdf(wo, wi)), DVec3::splat(i.z / PI), &format!("lambert pdf, {context}"));
+            }
+        }
+    }
+}
+
 /// `reflection()` is `None` unless both directions lie above the surface, as it documents, for
 /// the two pairs its sign tests alone would let through: both directions below (their half vector
 /// is below too, where `D` is 0), and two directions above the surface whose cosines multiply to 0
