@@ -589,6 +589,62 @@ fn a_hash_that_starts_a_word_of_a_name_is_part_of_it() {
     assert_eq!(material_of(&scene, 2).map_kd.as_deref(), Some(Path::new("mem/wood #2.png")));
 }
 
+/// Numbers as exporters write them, which tinyobjloader and Blender read: exponents (`1e-3`,
+/// `2.5E+1`), no digit before or after the point (`-.5`, `1.`, `.0`), an explicit plus sign, on
+/// coordinates as on face indices (`f +1/+1/+1 ...`) and MTL values.
+#[test]
+fn numbers_in_the_forms_exporters_write() {
+    let obj = "mtllib m.mtl\nv 1e-3 -.5 +2\nv 1. 2.5E+1 -0\nv .25 -1.5e-2 +.5\nvt 1.e-1 +0.5\nvn -0. 1E0 .0\n\
+               usemtl a\nf +1/+1/+1 +2/1/1 3/1/1\nf -3 +2 -1\n";
+    let scene = parse_with(obj, &[("m.mtl", "newmtl a\nKd .5 1. 25e-2\nNi +1.5\n")]);
+    assert!(scene.warnings.is_empty(), "{:#?}", scene.warnings);
+    let positions = [Vec3::new(0.001, -0.5, 2.0), Vec3::new(1.0, 25.0, 0.0), Vec3::new(0.25, -0.015, 0.5)];
+    assert_eq!(scene.mesh.positions, positions);
+    assert_eq!(scene.mesh.texcoords, [Vec2::new(0.1, 0.5)]);
+    assert_eq!(scene.mesh.normals, [Vec3::Y]);
+    assert_eq!(scene.mesh.indices, [[0, 1, 2]; 2]);
+    assert_eq!(scene.mesh.texcoord_indices, [[0; 3], NONE]);
+    assert_eq!(scene.mesh.normal_indices, [[0; 3], NONE]);
+    assert_eq!((material_of(&scene, 0).kd, material_of(&scene, 0).ni), (Vec3::new(0.5, 1.0, 0.25), 1.5));
+}
+
+/// A statement lumiere does not render, met before the first `newmtl`, belongs to no material: it
+/// costs the warning any statement there does, and the materials after it are read.
+#[test]
+fn an_unrendered_statement_before_the_first_newmtl_is_one_warning() {
+    let mtl = "map_Bump bumps.png\nnewmtl a\nKd 0 1 0\nmap_Bump bumps.png\n";
+    let scene = parse_with(&format!("mtllib m.mtl\n{SQUARE}usemtl a\nf 1 2 3\n"), &[("m.mtl", mtl)]);
+    let expected = [
+        "mem/m.mtl:1: statement before the first newmtl; line ignored",
+        "mem/m.mtl: material \"a\" uses statements lumiere does not render: \"map_Bump\" (see docs/MATERIALS.md)",
+    ];
+    assert_eq!(scene.warnings, expected);
+    assert_eq!(material_of(&scene, 0).kd, Vec3::Y);
+}
+
+/// `illum 9` is the specification's glass without ray-traced reflections, rendered as `illum 7`
+/// is (docs/MATERIALS.md): a glass, with its filter, and no warning; only a model past 9 is named.
+#[test]
+fn illumination_model_nine_is_a_glass_and_ten_is_named() {
+    let mtl = "newmtl nine\nNi 1.33\nTf 1 0.5 0.5\nillum 9\nnewmtl ten\nillum 10\n";
+    let scene = parse_with(&format!("mtllib m.mtl\n{SQUARE}usemtl nine\nf 1 2 3\n"), &[("m.mtl", mtl)]);
+    let expected =
+        "mem/m.mtl: material \"ten\" uses statements lumiere does not render: \"illum 10\" (see docs/MATERIALS.md)";
+    assert_eq!(scene.warnings, [expected]);
+    let glass = lumiere::materials::MaterialKind::Dielectric { eta: 1.33, tf: Vec3::new(1.0, 0.5, 0.5) };
+    assert_eq!(material_of(&scene, 0).kind(), glass);
+}
+
+/// A lone `-` is no texture option (an option is a `-` and a name): it is part of the file name.
+#[test]
+fn a_lone_dash_in_a_texture_statement_is_part_of_the_file_name() {
+    let mtl = "newmtl a\nmap_Kd - scan.png\nnewmtl b\nmap_d -clamp off - mask.png\n";
+    let scene = parse_with(&format!("mtllib m.mtl\n{SQUARE}usemtl a\nf 1 2 3\n"), &[("m.mtl", mtl)]);
+    assert!(scene.warnings.is_empty(), "{:#?}", scene.warnings);
+    assert_eq!(scene.materials[0].map_kd.as_deref(), Some(Path::new("mem/- scan.png")));
+    assert_eq!(scene.materials[1].map_d.as_deref(), Some(Path::new("mem/- mask.png")));
+}
+
 /// `d` wins over `Tr` whichever comes first, as tinyobjloader reads them (3ds Max writes both);
 /// `Tr` alone is `1 - d`, and the warning about its coverage names `Tr`, what the file wrote.
 /// `d 1` then `Tr 1` made an opaque material glass.
