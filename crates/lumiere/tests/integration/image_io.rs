@@ -93,6 +93,43 @@ fn aces_rises_to_white_and_never_turns_black() {
     assert!(exposed[1..].iter().all(|&v| v == 255), "every lit pixel is white at +64 stops: {exposed:?}");
 }
 
+/// The filmic curve's values, not only its shape: Narkowicz's fit `x (2.51 x + 0.03) / (x (2.43 x +
+/// 0.59) + 0.14)` of `x = 0.6 × radiance × 2^exposure`, then sRGB. Each code is the formula's in
+/// f64, at least 0.1 from a rounding edge (0.18 gives 104.60, 1 gives 214.12, 2 gives 236.11).
+#[test]
+fn aces_follows_narkowiczs_fit_after_the_exposure() {
+    let dir = TempDir::new("png-aces-values");
+    let path = dir.path("out.png");
+    let codes = |exposure: f32, radiance: &[f32]| {
+        let pixels: Vec<Vec3> = radiance.iter().map(|&c| g(c)).collect();
+        let style = PngStyle { encoding: PngEncoding::Srgb, exposure, tonemap: Tonemap::Aces };
+        write_image(&path, pixels.len() as u32, 1, &pixels, style).expect("write png");
+        let img = image::open(&path).expect("decode png").to_rgb8();
+        img.pixels().map(|p| p.0[0]).collect::<Vec<u8>>()
+    };
+    assert_eq!(codes(0.0, &[0.01, 0.05, 0.18, 1.0, 2.0, 7.0]), [6, 38, 105, 214, 236, 252]);
+    // +1 stop doubles the radiance, -2 stops quarter it, before the curve.
+    assert_eq!(codes(1.0, &[0.5, 1.0]), [214, 236]);
+    assert_eq!(codes(-2.0, &[4.0, 8.0]), [214, 236]);
+}
+
+/// An sRGB PNG says so (an `sRGB` chunk, perceptual intent), so that viewers show its codes as
+/// sRGB; gKit's linear bytes are not sRGB-encoded and carry no such chunk.
+#[test]
+fn only_srgb_pngs_carry_the_srgb_chunk() {
+    let dir = TempDir::new("png-chunk");
+    let path = dir.path("out.png");
+    for (encoding, intent) in
+        [(PngEncoding::Srgb, Some(png::SrgbRenderingIntent::Perceptual)), (PngEncoding::GkitLinear, None)]
+    {
+        write_image(&path, 2, 1, &[g(0.25), g(0.75)], encoding).expect("write png");
+        let reader = png::Decoder::new(std::io::Cursor::new(fs::read(&path).expect("read png")))
+            .read_info()
+            .expect("decode png header");
+        assert_eq!(reader.info().srgb, intent, "{encoding:?}");
+    }
+}
+
 #[test]
 fn png_gkit_linear_truncates_without_gamma() {
     let dir = TempDir::new("png-gkit");
@@ -137,6 +174,12 @@ fn exr_bytes_do_not_depend_on_the_order_tiles_finish_in() {
             assert!(bytes[0] == firsts[0], "round {round}: the image's EXR changed");
             assert!(bytes[1] == firsts[1], "round {round}: the layered EXR changed");
         }
+    }
+    // Where the tiles happen to finish in order (one core), equal bytes prove nothing: the header
+    // must fix the order too.
+    for bytes in &firsts {
+        let meta = exr::meta::MetaData::read_from_buffered(bytes.as_slice(), false).expect("read exr header");
+        assert!(meta.headers.iter().all(|h| h.line_order == exr::prelude::LineOrder::Increasing));
     }
 }
 

@@ -148,6 +148,52 @@ fn shared_edge_of_a_large_quad_is_hit_when_the_distance_falls_back_to_f64() {
     }
 }
 
+/// A ray exactly through an edge or a corner of a triangle hits it (the test is closed: edge
+/// functions of exactly 0 count as inside), whichever corner comes first and for both windings:
+/// an axis-aligned ray through a mesh on a grid meets such points, and rejecting them lets it slip
+/// between the triangles sharing the edge. At a scale of 1e20 the f32 products overflow and the
+/// whole test runs in f64, which must count them too.
+#[test]
+fn rays_exactly_on_an_edge_or_a_corner_hit() {
+    for scale in [1.0, 1e20] {
+        let corners =
+            [Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, -1.0, 0.0), Vec3::new(0.0, 1.0, 0.0)].map(|p| p * scale);
+        let midpoints = [0, 1, 2].map(|k| 0.5 * (corners[k] + corners[(k + 1) % 3]));
+        for target in corners.into_iter().chain(midpoints) {
+            for dir in [Vec3::Z, Vec3::NEG_Z] {
+                let ray = WatertightRay::new(&Ray::new(target - 2.0 * scale * dir, dir));
+                for first in 0..3 {
+                    let [a, b, c] = [0, 1, 2].map(|k| corners[(first + k) % 3]);
+                    for (a, b, c) in [(a, b, c), (a, c, b)] {
+                        let hit = intersect_triangle(&ray, f32::INFINITY, a, b, c);
+                        let t = hit.map(|h| h.t / scale);
+                        assert_eq!(t, Some(2.0), "ray along {dir} at {target} on ({a}, {b}, {c})");
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Where an edge function's two f32 products round to the same value, it is decided in f64: the
+/// ray below passes 2^-46 (in edge-function units) on one side of the edge shared by two triangles,
+/// so exactly the triangle on that side reports it, as exact arithmetic says. Taking the f32 zero
+/// as "on the edge" would report both.
+#[test]
+fn an_edge_function_rounding_to_zero_is_decided_in_f64() {
+    let e = f32::EPSILON; // 2^-23
+    // Edge b-c: cx * by = -(1 + 2^-22 + 2^-46) rounds to -(1 + 2^-22) = cy * bx.
+    let (b, c) = (Vec3::new(-1.0, -(1.0 + e), 0.0), Vec3::new(1.0 + e, 1.0 + 2.0 * e, 0.0));
+    let (below, above) = (Vec3::new(1.0, -1.0, 0.0), Vec3::new(-1.0, 1.0, 0.0));
+    let ray = WatertightRay::new(&Ray::new(Vec3::new(0.0, 0.0, -1.0), Vec3::Z));
+    // In exact arithmetic the origin of the xy plane lies on `above`'s side of the edge.
+    let exact = |p: Vec3, q: Vec3| p.x as f64 * q.y as f64 - p.y as f64 * q.x as f64;
+    assert!(exact(c, b) < 0.0 && exact(c, b) > -1e-13, "the ray passes a hair from the edge");
+    assert!(intersect_triangle(&ray, f32::INFINITY, below, b, c).is_none(), "the triangle on the far side");
+    let hit = intersect_triangle(&ray, f32::INFINITY, above, c, b).expect("the triangle on the ray's side");
+    assert_eq!(hit.t, 1.0);
+}
+
 #[test]
 fn the_dominant_axis_is_the_first_of_the_largest_magnitudes() {
     use lumiere::geometry::triangle::dominant_axis;
