@@ -249,6 +249,23 @@ fn visible_normal_sampling_round_trips() {
     }
 }
 
+/// GGX's Smith `Λ(ω)` for `α² = a2`, in f64 from its closed form.
+fn ggx_lambda(a2: f64, w: DVec3) -> f64 {
+    ((1.0 + a2 * (w.x * w.x + w.y * w.y) / (w.z * w.z)).sqrt() - 1.0) / 2.0
+}
+
+/// GGX's distribution of normals `D(m)` for `α² = a2`, in f64 from its closed form.
+fn ggx_d(a2: f64, m: DVec3) -> f64 {
+    let k = m.z * m.z + (m.x * m.x + m.y * m.y) / a2;
+    1.0 / (PI * a2 * k * k)
+}
+
+/// A direction above the surface, at least 3° off the horizon (where f32 and f64 part ways).
+fn upper_direction(rng: &mut TestRng) -> Vec3 {
+    let w = rng.direction();
+    Vec3::new(w.x, w.y, w.z.abs().max(0.05)).normalize()
+}
+
 /// Smith's terms against their closed forms, evaluated in f64 from the angles alone:
 /// `Λ = (√(1 + α² tan²θ) − 1) / 2`, `G1 = 1 / (1 + Λ)`, `G2 = 1 / (1 + Λo + Λi)` (symmetric to the
 /// last bit, between the separable `G1 G1` and the smaller `G1`), and `reflection()`'s value and
@@ -261,11 +278,7 @@ fn smith_terms_and_reflection_values_match_their_closed_forms() {
     for alpha in [0.05f64, 0.3, 0.8] {
         let ggx = Ggx::new(alpha as f32);
         let a2 = alpha * alpha;
-        let lambda = |w: DVec3| ((1.0 + a2 * (w.x * w.x + w.y * w.y) / (w.z * w.z)).sqrt() - 1.0) / 2.0;
-        let d = |m: DVec3| {
-            let k = m.z * m.z + (m.x * m.x + m.y * m.y) / a2;
-            1.0 / (PI * a2 * k * k)
-        };
+        let (lambda, d) = (|w| ggx_lambda(a2, w), |m| ggx_d(a2, m));
         let close = |got: f32, expected: f64, what: &str| {
             assert!(
                 (got as f64 - expected).abs() <= 2e-4 * expected.abs(),
@@ -273,12 +286,7 @@ fn smith_terms_and_reflection_values_match_their_closed_forms() {
             );
         };
         for _ in 0..5000 {
-            // Above the surface, at least 3° off the horizon (where f32 and f64 part ways).
-            let mut upper = || {
-                let w = rng.direction();
-                Vec3::new(w.x, w.y, w.z.abs().max(0.05)).normalize()
-            };
-            let (wo, wi) = (upper(), upper());
+            let (wo, wi) = (upper_direction(&mut rng), upper_direction(&mut rng));
             let (o, i) = (wo.as_dvec3(), wi.as_dvec3());
             let (lambda_o, lambda_i) = (lambda(o), lambda(i));
             close(ggx.lambda(wo), lambda_o, "Λ(ωo)");
@@ -323,22 +331,13 @@ fn lobe_values_and_pdfs_match_their_closed_forms() {
     let lambert = Lambert { reflectance: kd.as_vec3() };
     for alpha in [0.05f64, 0.3, 0.8] {
         let a2 = alpha * alpha;
-        let lambda = |w: DVec3| ((1.0 + a2 * (w.x * w.x + w.y * w.y) / (w.z * w.z)).sqrt() - 1.0) / 2.0;
-        let d = |m: DVec3| {
-            let k = m.z * m.z + (m.x * m.x + m.y * m.y) / a2;
-            1.0 / (PI * a2 * k * k)
-        };
+        let (lambda, d) = (|w| ggx_lambda(a2, w), |m| ggx_d(a2, m));
         let conductor = Conductor::new(f0.as_vec3(), alpha as f32);
         let plastic = Plastic::new(kd.as_vec3(), ks.as_vec3(), alpha as f32);
         let diffuse = kd * (1.0 - ks.max_element());
         let specular_probability = ks.element_sum() / (ks.element_sum() + diffuse.element_sum());
         for _ in 0..5000 {
-            // Above the surface, at least 3° off the horizon (where f32 and f64 part ways).
-            let mut upper = || {
-                let w = rng.direction();
-                Vec3::new(w.x, w.y, w.z.abs().max(0.05)).normalize()
-            };
-            let (wo, wi) = (upper(), upper());
+            let (wo, wi) = (upper_direction(&mut rng), upper_direction(&mut rng));
             let (o, i) = (wo.as_dvec3(), wi.as_dvec3());
             let h = (o + i).normalize();
             let mirror = d(h) / ((1.0 + lambda(o) + lambda(i)) * 4.0 * o.z * i.z);
