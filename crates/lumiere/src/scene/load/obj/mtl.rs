@@ -48,16 +48,14 @@ pub(super) fn parse_mtl(bytes: &[u8], path: &Path, warnings: &mut Warnings) -> V
         }
     };
     let bytes = joined.as_deref().unwrap_or(bytes);
-    let mut materials: Vec<Material> = Vec::new();
-    let mut notes: Vec<Notes> = Vec::new();
+    let mut materials: Vec<(Material, Notes)> = Vec::new();
     // After a `newmtl` without a name, whose statements belong to no material we could name.
     let mut nameless = false;
     for (i, line) in lines(bytes).enumerate() {
         let problem = match parse_statement(line, folder) {
             Ok(None) => continue,
             Ok(Some(Statement::NewMtl(name))) => {
-                materials.push(Material::default_grey(&name));
-                notes.push(Notes::default());
+                materials.push((Material::default_grey(&name), Notes::default()));
                 nameless = false;
                 continue;
             }
@@ -68,16 +66,12 @@ pub(super) fn parse_mtl(bytes: &[u8], path: &Path, warnings: &mut Warnings) -> V
                 "newmtl without a name: its statements, up to the next newmtl, are not read".to_string()
             }
             Ok(Some(_)) if nameless => continue,
-            Ok(Some(Statement::Unsupported(keyword))) if !materials.is_empty() => {
-                note(&mut notes, quote(&keyword));
-                continue;
-            }
-            Ok(Some(statement)) => match (materials.last_mut(), notes.last_mut()) {
-                (Some(material), Some(material_notes)) => {
+            Ok(Some(statement)) => match materials.last_mut() {
+                Some((material, notes)) => {
                     for option in statement.texture_options() {
-                        push_once(&mut material_notes.unsupported, option);
+                        notes.note_unsupported(option);
                     }
-                    statement.apply(material, material_notes);
+                    statement.apply(material, notes);
                     if let Some(clamped) = material.clamp_kd() {
                         warnings.push(path, "clamped colours", || {
                             format!("{}:{}: material {}: {clamped}", shown_path(path), i + 1, quote(&material.name))
@@ -85,29 +79,29 @@ pub(super) fn parse_mtl(bytes: &[u8], path: &Path, warnings: &mut Warnings) -> V
                     }
                     continue;
                 }
-                _ => "statement before the first newmtl".to_string(),
+                None => "statement before the first newmtl".to_string(),
             },
             Err(message) => message,
         };
         warnings.push(path, "ignored MTL lines", || format!("{}:{}: {problem}; line ignored", shown_path(path), i + 1));
     }
-    for (material, notes) in materials.iter().zip(notes) {
+    let warn_unrendered = |(material, notes): (Material, Notes)| {
         let mut ignored = notes.unsupported;
         // Without `d`, a coverage below 1 can only have come from `Tr`.
-        ignored.extend(unrendered_values(material, !notes.has_d));
-        if ignored.is_empty() {
-            continue;
+        ignored.extend(unrendered_values(&material, !notes.has_d));
+        if !ignored.is_empty() {
+            warnings.push(path, "unsupported MTL statements", || {
+                format!(
+                    "{}: material {} uses statements lumiere does not render: {} (see docs/MATERIALS.md)",
+                    shown_path(path),
+                    quote(&material.name),
+                    ignored.join(", ")
+                )
+            });
         }
-        warnings.push(path, "unsupported MTL statements", || {
-            format!(
-                "{}: material {} uses statements lumiere does not render: {} (see docs/MATERIALS.md)",
-                shown_path(path),
-                quote(&material.name),
-                ignored.join(", ")
-            )
-        });
-    }
-    materials
+        material
+    };
+    materials.into_iter().map(warn_unrendered).collect()
 }
 
 /// What parsing learns of a material besides its values.
@@ -120,14 +114,12 @@ struct Notes {
     has_d: bool,
 }
 
-/// Adds `what` to the current material's list of what it does not get, once.
-fn note(notes: &mut [Notes], what: String) {
-    push_once(&mut notes.last_mut().expect("notes for each material").unsupported, what);
-}
-
-fn push_once(list: &mut Vec<String>, what: String) {
-    if !list.contains(&what) {
-        list.push(what);
+impl Notes {
+    /// Adds `what` to the material's list of what it does not get, once.
+    fn note_unsupported(&mut self, what: String) {
+        if !self.unsupported.contains(&what) {
+            self.unsupported.push(what);
+        }
     }
 }
 
@@ -204,7 +196,8 @@ impl Statement {
             Statement::TransmissionFilter(tf) => material.tf = tf,
             Statement::Metallic(pm) => material.metallic = Some(pm),
             Statement::Roughness(pr) => material.roughness = Some(pr),
-            Statement::NewMtl(_) | Statement::NamelessMtl | Statement::Transparency(_) | Statement::Unsupported(_) => {}
+            Statement::Unsupported(keyword) => notes.note_unsupported(quote(&keyword)),
+            Statement::NewMtl(_) | Statement::NamelessMtl | Statement::Transparency(_) => {}
         }
     }
 }
