@@ -54,6 +54,17 @@ def cluster():
         cluster.shutdown()
 
 
+@pytest.fixture(autouse=True)
+def no_ray_cancel(monkeypatch):
+    """``ray.cancel`` is never called: cancelling a task at the moment its result arrives aborts
+    the driver process in Ray (``Tried to complete task that was not pending``), which it did in
+    this file's test of a stale scene, one run in four. Tasks stop by themselves instead."""
+    calls = []
+    monkeypatch.setattr(ray, "cancel", lambda *args, **kwargs: calls.append(args))
+    yield
+    assert not calls, "ray.cancel was called"
+
+
 def test_bytes_equal_a_local_render_whatever_the_split(cluster):
     scene = lumiere.builtin()
     local = lumiere.render(scene, spp=12, size=(64, 48), seed=4)
@@ -159,6 +170,32 @@ def test_checkpoints_hold_the_seconds_so_far_and_replace_a_film_only_with_a_larg
     assert seen and 0 not in seen, seen
     samples, seconds = checkpoint_header(checkpoint)
     assert samples >= 4 and seconds > 0
+
+
+def test_an_abandoned_render_frees_the_cluster(cluster):
+    # Four tasks of 4,000 passes of 100,000 AO rays per pixel (over a minute a task), abandoned as
+    # soon as two run: were they not to stop, the render after it would wait minutes for a CPU.
+    class Stop(Exception):
+        pass
+
+    def progress(done, total):
+        if len(_render_processes()) == 2:
+            raise Stop
+
+    scene = lumiere.builtin()
+    with pytest.raises(Stop):
+        distributed.render(scene, mode="ao", samples=100_000, spp=16_000, size=(8, 6), address=cluster.address,
+                           tasks=4, progress=progress)
+    start = time.monotonic()
+    local = lumiere.render(scene, spp=2, size=(8, 6))
+    assert np.array_equal(bits(distributed.render(scene, spp=2, size=(8, 6), address=cluster.address, tasks=2)), bits(local))
+    # A task stops within ABANDON_POLL_SECONDS of the driver giving up, or as soon as it starts.
+    assert time.monotonic() - start < 30
+    # A worker retitles itself idle just after it returns its result.
+    deadline = time.monotonic() + 5
+    while _render_processes() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert not _render_processes()
 
 
 def test_a_scene_file_a_worker_cannot_read_is_named(cluster, tmp_path):

@@ -21,7 +21,8 @@ import math
 import os
 import socket
 import time
-from typing import Any, Dict, List, Optional, Sequence, Tuple
+import uuid
+from typing import Any, Dict, List, Optional, Sequence, Set, Tuple
 
 import numpy as np
 
@@ -40,6 +41,11 @@ TASK_BYTES = 256 << 20
 #: How long the driver waits for the next task's passes before it reports progress again (and
 #: Python sees a Ctrl-C).
 WAIT_SECONDS = 0.5
+
+#: How often a task asks whether its render was given up: the longest a task renders on after an
+#: error or a Ctrl-C in the driver (one question a second per task is little for the one actor
+#: that answers them all, even on a cluster of thousands of CPUs).
+ABANDON_POLL_SECONDS = 1.0
 
 
 class ClusterUnreachable(ConnectionError):
@@ -113,14 +119,91 @@ def split_passes(first: int, end: int, tasks: int) -> List[Tuple[int, int]]:
     return [r for r in ranges if r[1] > 0]
 
 
+class _Abandonments:
+    """The renders a driver gave up (an error, a Ctrl-C), which their tasks poll so as to stop:
+    a Ray actor, one per driver process (:func:`_abandonments`).
+
+    Not ``ray.cancel``: in Ray (2.60 included) cancelling a task at the moment its result arrives
+    marks it failed between the two steps of its completion, and the driver process aborts
+    ("Tried to complete task that was not pending", task_manager.cc), which took down a test run.
+    A task that stops by itself races nothing."""
+
+    def __init__(self) -> None:
+        self._abandoned: Set[str] = set()
+
+    def abandon(self, render: str) -> None:
+        self._abandoned.add(render)
+
+    def abandoned(self, render: str) -> bool:
+        return render in self._abandoned
+
+
+#: This driver's :class:`_Abandonments` actor, with the Ray job it belongs to.
+_abandonments_actor: Optional[Tuple[str, Any]] = None
+
+
+def _abandonments(ray: Any) -> Any:
+    """This driver's :class:`_Abandonments` actor, started by its first render and kept for the
+    next ones: an actor per render cost a worker process started and stopped each time (0.26 s a
+    render on a 2-core machine). No CPU: it must start on a cluster whose CPUs the tasks hold. A
+    node lost takes it along and Ray restarts it elsewhere (with the renders given up
+    forgotten, which can only let tasks run on)."""
+    global _abandonments_actor
+    job = ray.get_runtime_context().get_job_id()
+    if _abandonments_actor is None or _abandonments_actor[0] != job:
+        actor = ray.remote(_Abandonments).options(num_cpus=0, max_restarts=-1, max_task_retries=-1).remote()
+        _abandonments_actor = (job, actor)
+    return _abandonments_actor[1]
+
+
+class _Abandoned(Exception):
+    """Raised in a task's progress callback to stop its render once the driver gave it up."""
+
+
+def _stop_when_abandoned(ray: Any, abandonments: Any, render: str) -> Any:
+    """A progress callback for the task's render that raises :class:`_Abandoned` once the driver
+    has given up ``render`` (in ``abandonments``). It asks every :data:`ABANDON_POLL_SECONDS` and
+    never waits for the answer (a render is not slowed by a busy or starting actor); an actor that
+    cannot answer is taken for a render still wanted."""
+    question = abandonments.abandoned.remote(render)
+    next_question = time.monotonic() + ABANDON_POLL_SECONDS
+    actor_gone = False  # no more questions then
+
+    def progress(done: int, total: int) -> None:
+        nonlocal question, next_question, actor_gone
+        if question is not None and ray.wait([question], timeout=0)[0]:
+            try:
+                abandoned = ray.get(question)
+            except ray.exceptions.RayError:
+                abandoned, actor_gone = False, True
+            if abandoned:
+                raise _Abandoned
+            question = None
+        if question is None and not actor_gone and time.monotonic() >= next_question:
+            question = abandonments.abandoned.remote(render)
+            next_question = time.monotonic() + ABANDON_POLL_SECONDS
+
+    return progress
+
+
 def _render_range(
-    scene_recipe: tuple, camera_recipe: tuple, option_args: Dict[str, Any], first: int, count: int, threads: int
+    scene_recipe: tuple,
+    camera_recipe: tuple,
+    option_args: Dict[str, Any],
+    first: int,
+    count: int,
+    threads: int,
+    abandonments: Any,
+    render: str,
 ) -> Dict[str, Any]:
-    """The Ray task: passes ``first .. first + count``, each as ``(sample, float32 array, rays)``.
+    """The Ray task: passes ``first .. first + count``, each as ``(sample, float32 array, rays)``;
+    ``{"abandoned": True}`` where the driver gave up ``render`` (in ``abandonments``, an
+    :class:`_Abandonments`) before the task was done.
 
     The scene and camera come as their recipes and are rebuilt here, in the task, rather than
     unpickled by Ray while it prepares the task's arguments: a file missing on this node is then
     an error naming the node and the file, not a Ray system error."""
+    ray = _ray()
     start, cpu = time.perf_counter(), time.process_time()
     host = socket.gethostname()
     try:
@@ -131,7 +214,12 @@ def _render_range(
             "on every node, at the same path?)"
         ) from None
     options = _lumiere.NativeOptions(**option_args)
-    passes = _lumiere.render_passes(scene._native, camera._native, options, first, count, threads)
+    progress = _stop_when_abandoned(ray, abandonments, render)
+    try:
+        passes = _lumiere.render_passes(scene._native, camera._native, options, first, count, threads, progress)
+    except _Abandoned:
+        # Returned, not raised: nothing reads it, and an error nobody reads is printed by Ray.
+        return {"abandoned": True}
     return {
         "first": first,
         "passes": [(sample, np.frombuffer(values, dtype=np.float32), rays) for sample, values, rays in passes],
@@ -277,10 +365,11 @@ def render_full(
     ranges = split_passes(film.samples, spp, max(wanted, math.ceil((spp - film.samples) / passes_per_task)))
     task = ray.remote(_render_range).options(num_cpus=threads_per_task, max_retries=max_retries)
     scene_ref, camera_ref = ray.put(scene._recipe), ray.put(camera._recipe)
+    abandonments, render = _abandonments(ray), uuid.uuid4().hex
     # By first pass. Results are fetched in pass order, one at a time, so that the driver holds
     # one task's passes at most; the others wait in Ray's object store.
     pending = {
-        first: (task.remote(scene_ref, camera_ref, option_args, first, count, threads_per_task), count)
+        first: (task.remote(scene_ref, camera_ref, option_args, first, count, threads_per_task, abandonments, render), count)
         for first, count in ranges
     }
     description = options.describe(camera._native)
@@ -313,15 +402,15 @@ def render_full(
             if checkpoint is not None and film.samples > saved_samples and time.monotonic() - last_checkpoint >= checkpoint_every:
                 save()
     except BaseException:
-        # The film first: cancelling needs the cluster, which may be what failed.
+        # The film first: telling the tasks needs the cluster, which may be what failed.
         try:
             if checkpoint is not None and film.samples > saved_samples:
                 save()
         finally:
-            for ref, _ in pending.values():
-                # The error being raised is what the caller must see, not a failed cancel's.
-                with contextlib.suppress(Exception):
-                    ray.cancel(ref, force=True)
+            # The tasks still running stop within ABANDON_POLL_SECONDS, those not yet started
+            # as they start. The error being raised is what the caller must see, not this one's.
+            with contextlib.suppress(Exception):
+                abandonments.abandon.remote(render)
         raise
     seconds = time.perf_counter() - start
     if checkpoint is not None:
