@@ -603,16 +603,24 @@ fn ctrl_c_while_loading_exits_3_and_writes_nothing() {
     let mut gz = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
     std::io::Write::write_all(&mut gz, text.as_bytes()).unwrap();
     let scene = dir.write("big.obj.gz", gz.finish().unwrap());
-    let child = lumiere()
-        .args(["render", scene.to_str().unwrap(), "--size", "8x6", "-o", &dir.arg("o.png")])
+    // `--samples` does nothing in the default mode: its warning is written after the handler is
+    // installed and just before the scene loads, so the signal is sent once it is read rather than
+    // at a guessed moment (150 ms after the start would be too early for a process slow to start,
+    // and too late where loading and building take less than that).
+    let mut child = lumiere()
+        .args(["render", scene.to_str().unwrap(), "--samples", "4", "--size", "8x6", "-o", &dir.arg("o.png")])
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    std::thread::sleep(Duration::from_millis(150));
+    let mut lines = std::io::BufReader::new(child.stderr.take().unwrap());
+    let mut text = String::new();
+    std::io::BufRead::read_line(&mut lines, &mut text).unwrap();
+    assert!(text.contains("--samples has no effect in --mode path"), "{text}");
     assert!(Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap().success());
-    let out = child.wait_with_output().unwrap();
-    assert_eq!(out.status.code(), Some(3), "{}", stderr(&out));
-    assert!(stderr(&out).contains("interrupted while loading"), "{}", stderr(&out));
+    let status = child.wait().unwrap();
+    std::io::Read::read_to_string(&mut lines, &mut text).unwrap();
+    assert_eq!(status.code(), Some(3), "{text}");
+    assert!(text.contains("interrupted while loading"), "{text}");
     assert_eq!(dir.entries(), ["big.obj.gz"]);
 }
 
