@@ -227,12 +227,19 @@ fn killed_and_resumed_renders_give_identical_bytes() {
     let args =
         ["render", "--mode", "direct", "--samples", "8", "--spp", "96", "--size", "256x192", "--sampler", "sobol"];
     let reference = dir.arg("reference.pfm");
+    let start = Instant::now();
     let run = lumiere(&[&args[..], &["-o", &reference]].concat());
+    let took = start.elapsed();
     assert!(run.status.success(), "{}", stderr(&run));
     let expected = fs::read(&reference).unwrap();
 
+    // The kill points are fractions of the reference render's time (40, 150, 330 and 520 ms of
+    // the 1.5 s it took on the 2-core machine), so that they land at the same points of the
+    // render on a faster or slower machine: with fixed times, a machine twice as fast would see
+    // fewer kills land, and the count below could fall short.
     let mut total_kills = 0;
-    for (attempt, delay_ms) in [40u64, 150, 330, 520].into_iter().enumerate() {
+    let delays = [40u32, 150, 330, 520].map(|ms| took * ms / 1500);
+    for (attempt, delay) in delays.into_iter().enumerate() {
         let out = dir.arg(&format!("resumed{attempt}.pfm"));
         let checkpoint = dir.arg(&format!("run{attempt}.ckpt"));
         let mut kills = 0;
@@ -243,7 +250,7 @@ fn killed_and_resumed_renders_give_identical_bytes() {
             }
             let mut child = spawn(&[&args[..], &command].concat());
             if kills < 3 {
-                std::thread::sleep(Duration::from_millis(delay_ms * (kills + 1)));
+                std::thread::sleep(delay * (kills + 1));
                 if child.try_wait().unwrap().is_none() {
                     signal(&child, "KILL");
                     let _ = child.wait();
