@@ -183,3 +183,104 @@ fn sobol_lowers_the_error_of_soft_shadows() {
     let (independent, sobol) = (rmse(SamplerKind::Independent), rmse(SamplerKind::Sobol));
     assert!(sobol < 0.75 * independent, "Sobol RMSE {sobol} vs independent {independent}");
 }
+
+/// A plastic floor (diffuse under a GGX layer): its BSDF depends on `wi`, so that the direct
+/// estimator evaluates it per light sample instead of as one Lambertian `f`.
+fn plastic() -> Material {
+    Material { ks: Vec3::splat(0.5), ns: 20.0, illum: 2, ..diffuse(0.4) }
+}
+
+/// The receiver of the glossy tests, away from the world's origin: a receiver at the origin (as in
+/// the tests above) has shadow segments `target - origin` equal to `target + origin`.
+const RECEIVER: Vec3 = Vec3::new(3.0, 0.0, 2.0);
+
+/// A square light of half-size 0.3 at height 1 facing down (the winding of `horizontal(.., true)`),
+/// 0.6 behind the receiver, so that the mirror direction of a view from `RECEIVER + (0, 1.5, 1)`,
+/// `(0, 1.5, -1)`, meets it and the camera's ray to the receiver passes beside it.
+fn light_behind_the_receiver() -> [Vec3; 4] {
+    let (h, s, cz) = (1.0, 0.3, -0.6);
+    [Vec3::new(-s, h, cz - s), Vec3::new(s, h, cz - s), Vec3::new(s, h, cz + s), Vec3::new(-s, h, cz + s)]
+        .map(|c| c + RECEIVER)
+}
+
+/// A glossy floor under a square light placed in its mirror direction: both light-sampling
+/// strategies, with both samplers, converge to the outgoing radiance
+/// `∫ f(wo, wi) Le cos θ cos θ' / d² dA` over the light, here by midpoint quadrature in f64 with
+/// the material's own `eval`. The Lambertian tests above never reach the per-sample BSDF path.
+#[test]
+fn direct_light_on_a_glossy_floor_matches_quadrature_of_its_bsdf() {
+    use lumiere::materials::{Bsdf, MaterialKind};
+    use lumiere::math::Frame;
+    let le = 10.0f32;
+    let plastic = plastic();
+    assert!(matches!(plastic.kind(), MaterialKind::Plastic { .. }));
+    let light = light_behind_the_receiver();
+    let world = scene_of_quads(&[(horizontal(0.0, 20.0, false), 0), (light, 1)], vec![plastic.clone(), emitter(le)]);
+    let eye = RECEIVER + Vec3::new(0.0, 1.5, 1.0);
+    let bsdf = plastic.bsdf(plastic.kd);
+    assert!(bsdf.lambertian_eval(Vec3::Z).is_none(), "the floor's BSDF must depend on wi");
+    let frame = Frame::from_normal(Vec3::Y);
+    let wo = frame.to_local((eye - RECEIVER).normalize());
+    let (corner, side) = ((light[0] - RECEIVER).as_dvec3(), (light[2].x - light[0].x) as f64);
+    let cells = 400;
+    let cell = side / cells as f64;
+    let mut expected = 0.0f64;
+    for i in 0..cells {
+        for j in 0..cells {
+            let p = corner + glam::DVec3::new((i as f64 + 0.5) * cell, 0.0, (j as f64 + 0.5) * cell);
+            let d2 = p.length_squared();
+            let wi = p / d2.sqrt();
+            let f = bsdf.eval(wo, frame.to_local(wi.as_vec3())).x as f64;
+            // cos θ at the floor and cos θ' at the light are both wi.y.
+            expected += f * le as f64 * wi.y * wi.y / d2 * cell * cell;
+        }
+    }
+    for sampler in [SamplerKind::Independent, SamplerKind::Sobol] {
+        for light_sampling in [LightSampling::PerLight, LightSampling::Power] {
+            let options = |seed| direct_options(1024, seed, sampler, light_sampling);
+            let (mean, error) = mean_and_error(32, |seed| estimate(&world, eye, RECEIVER, &options(seed)));
+            let context = format!("{sampler:?} {light_sampling:?}");
+            // The pixel's footprint (1°) moves the answer by far less than 1e-3 of it.
+            assert!(
+                (mean - expected).abs() < 4.0 * error.max(1e-3 * expected),
+                "{context}: {mean} +- {error}, expected {expected}"
+            );
+            assert!(error < 0.01 * expected, "{context}: standard error {error}");
+        }
+    }
+}
+
+/// The same light hidden from the receiver by an opaque square between them (but not from the
+/// camera) leaves the floor black, glossy or diffuse, whatever the light sampling; without the
+/// blocker the floor is lit. The receiver is away from the world's origin, so that a shadow segment
+/// must really run from the receiver to its light point (`target - origin`, where `target + origin`
+/// or `target / origin` lit nothing here).
+#[test]
+fn a_floor_whose_light_is_hidden_by_a_blocker_is_black() {
+    // At height 0.5, the shaft from the receiver to the light spans x in [-0.15, 0.15] and z in
+    // [-0.45, -0.15] around the receiver; the camera's ray crosses that height at z = +1/3.
+    let blocker =
+        [Vec3::new(-0.4, 0.5, -0.6), Vec3::new(-0.4, 0.5, 0.0), Vec3::new(0.4, 0.5, 0.0), Vec3::new(0.4, 0.5, -0.6)]
+            .map(|c| c + RECEIVER);
+    let eye = RECEIVER + Vec3::new(0.0, 1.5, 1.0);
+    for floor in [plastic(), diffuse(0.8)] {
+        let world = scene_of_quads(
+            &[(horizontal(0.0, 20.0, false), 0), (light_behind_the_receiver(), 1), (blocker, 0)],
+            vec![floor.clone(), emitter(10.0)],
+        );
+        for light_sampling in [LightSampling::PerLight, LightSampling::Power] {
+            for samples in [1, 17, 64] {
+                let options = direct_options(samples, 7, SamplerKind::Independent, light_sampling);
+                let value = estimate(&world, eye, RECEIVER, &options);
+                assert_eq!(value, 0.0, "{:?} floor, {light_sampling:?}, N = {samples}", floor.kind());
+            }
+        }
+        // Without the blocker the same floor is lit.
+        let world = scene_of_quads(
+            &[(horizontal(0.0, 20.0, false), 0), (light_behind_the_receiver(), 1)],
+            vec![floor.clone(), emitter(10.0)],
+        );
+        let options = direct_options(64, 7, SamplerKind::Independent, LightSampling::PerLight);
+        assert!(estimate(&world, eye, RECEIVER, &options) > 0.0, "{:?} floor unblocked", floor.kind());
+    }
+}
