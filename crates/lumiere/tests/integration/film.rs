@@ -21,6 +21,11 @@ const HEIGHT: u32 = 3;
 /// Pass `k`'s values: ordinary ones, and the ones the film must count as 0 or must not keep as
 /// they are (NaN, infinities, negatives, -0, a denormal, the largest float).
 fn pass(k: u32) -> PassSamples {
+    pass_of_size(k, WIDTH, HEIGHT)
+}
+
+/// [`pass`] for a film of `width` x `height`.
+fn pass_of_size(k: u32, width: u32, height: u32) -> PassSamples {
     let odd = [
         Vec3::new(f32::NAN, 1.0, 1.0),
         Vec3::new(0.5, f32::INFINITY, 0.0),
@@ -31,13 +36,13 @@ fn pass(k: u32) -> PassSamples {
         Vec3::new(f32::MIN_POSITIVE / 4.0, 1e-3, 7.0),
         Vec3::new(f32::MAX, 1.0, 0.0),
     ];
-    let values = (0..WIDTH * HEIGHT)
+    let values = (0..width * height)
         .map(|p| {
             let ordinary = Vec3::new(0.1 * (p + k) as f32, 1.0 / (1 + p * k) as f32, (p as f32).sqrt() / 3.0);
             if (p + k).is_multiple_of(2) { odd[((p + 3 * k) % 8) as usize] } else { ordinary }
         })
         .collect();
-    PassSamples { sample: k, width: WIDTH, height: HEIGHT, values, rays: 1 }
+    PassSamples { sample: k, width, height, values, rays: 1 }
 }
 
 /// The film's definition, written out plainly: f64 sums from zero, one addition per pass, invalid
@@ -87,6 +92,53 @@ fn every_form_holds_the_bits_of_one_addition_per_pass() {
         let mean: Vec<u32> = reference.sum.iter().flat_map(|s| s.map(|c| ((c * scale) as f32).to_bits())).collect();
         assert_eq!(image_bits(&film), mean, "after {} passes", k + 1);
     }
+}
+
+/// The same for a film of more pixels than the film adds in one parallel job (8,192): pixels of
+/// every chunk, not only the first, get their own first pass's values when a one-pass film becomes
+/// sums. (The films above fit in one chunk, where chunk 0's offset is 0 however it is computed.)
+#[test]
+fn a_film_of_several_chunks_holds_the_bits_of_one_addition_per_pass() {
+    let (width, height) = (128, 70);
+    let pixels = (width * height) as usize;
+    assert!(pixels > 8192, "at least two chunks");
+    let mut film = Film::new(width, height).unwrap();
+    let mut reference = Reference { sum: vec![[0.0; 3]; pixels], sum_sq: vec![0.0; pixels], discarded: 0 };
+    for k in 0..3 {
+        film.add_pass(&pass_of_size(k, width, height)).unwrap();
+        reference.add(&pass_of_size(k, width, height));
+        let expected = reference.sum.iter().copied().zip(reference.sum_sq.iter().copied());
+        assert_eq!(bits(film.moments()), bits(expected), "after {} passes", k + 1);
+        assert_eq!((film.samples, film.discarded), (k + 1, reference.discarded));
+    }
+}
+
+/// Films are equal only where their sizes, counts, sums and second moments all are: equality is
+/// what tells a resumed or distributed render from the one it must reproduce, so a film that
+/// differs in any one of them, and only in it, is not equal.
+#[test]
+fn films_differing_in_one_sum_or_count_are_unequal() {
+    let film_of = |width: u32, height: u32, passes: &[Vec<Vec3>]| {
+        let mut film = Film::new(width, height).unwrap();
+        for (k, values) in passes.iter().enumerate() {
+            film.add_pass(&PassSamples { sample: k as u32, width, height, values: values.clone(), rays: 0 }).unwrap();
+        }
+        film
+    };
+    let (a, b) = (Vec3::new(1.0, 2.0, 3.0), Vec3::new(0.5, 0.25, 4.0));
+    let film = film_of(2, 1, &[vec![a, b], vec![b, a]]);
+    assert_eq!(film, film_of(2, 1, &[vec![a, b], vec![b, a]]));
+    // One component of one sample, one bit above: other sums.
+    let nudged = Vec3::new(f32::from_bits(b.x.to_bits() + 1), b.y, b.z);
+    assert_ne!(film, film_of(2, 1, &[vec![a, b], vec![nudged, a]]), "another sum");
+    // The same values in a 1x2 film: equal sums, another size.
+    assert_ne!(film, film_of(1, 2, &[vec![a, b], vec![b, a]]), "another size");
+    // A third pass of zeros: equal sums and second moments, another sample count.
+    assert_ne!(film, film_of(2, 1, &[vec![a, b], vec![b, a], vec![Vec3::ZERO; 2]]), "another count");
+    // A zero that was a NaN: equal sums, another count of discarded samples.
+    let (zeros, nans) = (film_of(2, 1, &[vec![Vec3::ZERO, a]]), film_of(2, 1, &[vec![Vec3::NAN, a]]));
+    assert_eq!(zeros.moments().collect::<Vec<_>>(), nans.moments().collect::<Vec<_>>());
+    assert_ne!(zeros, nans, "another discarded count");
 }
 
 /// A forged checkpoint can hold a film at the largest count: another pass is refused, and the film
