@@ -617,8 +617,9 @@ fn ctrl_c_while_loading_exits_3_and_writes_nothing() {
     std::io::BufRead::read_line(&mut lines, &mut text).unwrap();
     assert!(text.contains("--samples has no effect in --mode path"), "{text}");
     assert!(Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap().success());
-    let status = child.wait().unwrap();
+    // Read to the end (the child's exit) before waiting: a child blocked on a full pipe never exits.
     std::io::Read::read_to_string(&mut lines, &mut text).unwrap();
+    let status = child.wait().unwrap();
     assert_eq!(status.code(), Some(3), "{text}");
     assert!(text.contains("interrupted while loading"), "{text}");
     assert_eq!(dir.entries(), ["big.obj.gz"]);
