@@ -3,17 +3,22 @@
 
 use glam::Vec3;
 use lumiere::accel::BuildPreset;
-use lumiere::integrators::{Direct, LightSampling, Technique};
+use lumiere::integrators::{Direct, LightSampling, Path, PathStrategy, Technique};
 use lumiere::materials::Material;
 use lumiere::render::{RenderOptions, render};
 use lumiere::sampler::SamplerKind;
 use lumiere::scene::Scene;
 use lumiere::scene::camera::Camera;
-use lumiere::scene::mesh::TriangleMesh;
+use lumiere::scene::mesh::{NO_INDEX, TriangleMesh};
 use lumiere::world::World;
 
 /// Builds a scene from quads `(corners, material)`, each split into two triangles `(a,b,c), (a,c,d)`.
 fn scene_of_quads(quads: &[([Vec3; 4], usize)], materials: Vec<Material>) -> World {
+    world_of(mesh_of_quads(quads), materials)
+}
+
+/// The triangles of [`scene_of_quads`], without normals or texture coordinates.
+fn mesh_of_quads(quads: &[([Vec3; 4], usize)]) -> TriangleMesh {
     let mut mesh = TriangleMesh::default();
     for (corners, material) in quads {
         let base = mesh.positions.len() as u32;
@@ -22,6 +27,10 @@ fn scene_of_quads(quads: &[([Vec3; 4], usize)], materials: Vec<Material>) -> Wor
         mesh.indices.push([base, base + 2, base + 3]);
         mesh.material_ids.extend([*material as u32; 2]);
     }
+    mesh
+}
+
+fn world_of(mesh: TriangleMesh, materials: Vec<Material>) -> World {
     let scene = Scene::from_parts("test".into(), mesh, materials, vec![]).expect("valid test scene");
     World::new(scene, BuildPreset::Default)
 }
@@ -277,5 +286,62 @@ fn a_floor_whose_light_is_hidden_by_a_blocker_is_black() {
         );
         let options = direct_options(64, 7, SamplerKind::Independent, LightSampling::PerLight);
         assert!(estimate(&world, eye, RECEIVER, &options) > 0.0, "{:?} floor unblocked", floor.kind());
+    }
+}
+
+/// A small floor whose shading normals lean 45 degrees towards a light that stands across its
+/// plane: the part of the light below the floor's geometric plane lies above the shading normals'
+/// horizon but cannot light the floor's top (light from there would pass through the floor). So
+/// the floor, glossy or diffuse, must shine as under the light's part above the plane alone, by
+/// direct lighting with either light sampling and by the path tracer (direct light only) with each
+/// strategy. Direct lighting's batches leave the floor's own triangles out (their shaft is cut by
+/// the surface), and the path tracer spawns a segment on the side it leaves by: only the tests of
+/// the geometric normal keep that light out.
+#[test]
+fn light_below_the_geometric_surface_does_not_leak_through_shading_normals() {
+    let receiver =
+        [Vec3::new(-0.2, 0.0, -0.2), Vec3::new(-0.2, 0.0, 0.2), Vec3::new(0.2, 0.0, 0.2), Vec3::new(0.2, 0.0, -0.2)];
+    // A light in the plane x = 1 facing -x, over heights `bottom..0.25`.
+    let light = |bottom: f32| {
+        [
+            Vec3::new(1.0, bottom, -0.5),
+            Vec3::new(1.0, bottom, 0.5),
+            Vec3::new(1.0, 0.25, 0.5),
+            Vec3::new(1.0, 0.25, -0.5),
+        ]
+    };
+    let leaning = Vec3::new(1.0, 1.0, 0.0).normalize();
+    let world = |bottom: f32, floor: &Material| {
+        let quads = [(receiver.map(|c| c + RECEIVER), 0), (light(bottom).map(|c| c + RECEIVER), 1)];
+        let mut mesh = mesh_of_quads(&quads);
+        mesh.normals = vec![leaning];
+        mesh.normal_indices = vec![[0; 3], [0; 3], [NO_INDEX; 3], [NO_INDEX; 3]];
+        world_of(mesh, vec![floor.clone(), emitter(10.0)])
+    };
+    let direct = |light_sampling| (Technique::Direct(Direct { samples: 256, light_sampling }), 1);
+    let path = |strategy| (Technique::Path(Path { max_depth: 2, strategy, ..Path::default() }), 1024);
+    let techniques = [
+        direct(LightSampling::PerLight),
+        direct(LightSampling::Power),
+        path(PathStrategy::Mis),
+        path(PathStrategy::LightsOnly),
+        path(PathStrategy::BsdfOnly),
+    ];
+    // Seen from above both normals; the camera's ray passes beside the light.
+    let eye = RECEIVER + Vec3::new(0.5, 1.5, 1.0);
+    for floor in [plastic(), diffuse(0.8)] {
+        let (across, above) = (world(-1.0, &floor), world(0.0, &floor));
+        for (technique, spp) in techniques {
+            let options = |seed| RenderOptions { seed, spp, ..RenderOptions::new(technique) };
+            let (leaked, leaked_error) = mean_and_error(32, |seed| estimate(&across, eye, RECEIVER, &options(seed)));
+            let (lit, lit_error) = mean_and_error(32, |seed| estimate(&above, eye, RECEIVER, &options(seed)));
+            let context = format!("{:?} floor, {technique:?}", floor.kind());
+            assert!(lit > 0.0 && lit_error < 0.1 * lit, "{context}: the light's upper part gives {lit} +- {lit_error}");
+            let bound = 4.0 * (leaked_error.powi(2) + lit_error.powi(2)).sqrt();
+            assert!(
+                (leaked - lit).abs() < bound,
+                "{context}: {leaked} +- {leaked_error} with the light across the plane, {lit} +- {lit_error} above it"
+            );
+        }
     }
 }
