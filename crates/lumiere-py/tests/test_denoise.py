@@ -27,7 +27,7 @@ def test_what_is_not_an_image_is_refused_before_pyoidn_is_needed(monkeypatch):
 
 
 def test_denoising_brings_a_noisy_render_closer_to_the_reference():
-    optional("pyoidn", "pip install 'lumiere[denoise]'")
+    optional("pyoidn", "pip install pyoidn")
     scene = lumiere.builtin()
     reference = lumiere.render(scene, spp=256, size=(64, 48), seed=1)
     noisy = lumiere.render(scene, spp=4, size=(64, 48), aovs=("albedo", "normal"))

@@ -18,7 +18,7 @@ import lumiere
 
 from conftest import optional  # noqa: E402
 
-ray = optional("ray", "pip install 'lumiere[ray]'")
+ray = optional("ray", "pip install ray")
 from ray.cluster_utils import Cluster  # noqa: E402
 
 import lumiere.distributed as distributed  # noqa: E402

@@ -354,7 +354,7 @@ fn resuming_with_other_inputs_or_a_broken_file_is_refused() {
         // A refusal names the option that differs, with both values.
         (
             &["render", "--mode", "ao", "--samples", "8", "--spp", "4", "--size", "32x24"],
-            "other options: technique (checkpoint: --mode ao --samples 4 --ao-distance inf; now: --mode ao --samples 8",
+            "other options: technique (checkpoint: --mode ao --samples 4; now: --mode ao --samples 8",
         ),
         (
             &["render", "--mode", "ao", "--samples", "4", "--spp", "4", "--size", "32x24", "--seed", "9"],

@@ -7,9 +7,9 @@
 
 :func:`load` and :func:`builtin` give a :class:`Scene` (or :meth:`Scene.from_arrays`), a
 :class:`Camera` frames it, :func:`render` returns a float32 numpy array (``height, width, 3``),
-:func:`denoise` cleans it with Intel Open Image Denoise (``pip install 'lumiere[denoise]'``), and
+:func:`denoise` cleans it with Intel Open Image Denoise (``pip install pyoidn``), and
 :mod:`lumiere.distributed` splits a render across a Ray cluster with the same bytes
-(``pip install 'lumiere[ray]'``). Errors are :class:`LumiereError` (a ``ValueError``) or
+(``pip install ray``). Errors are :class:`LumiereError` (a ``ValueError``) or
 :class:`LumiereOSError` (an ``OSError``) with the CLI's messages. See docs/PYTHON.md.
 """
 

@@ -1,5 +1,5 @@
 """``lumiere.denoise``: Intel Open Image Denoise through ``pyoidn`` (which ships the OIDN library
-itself), an optional dependency: ``pip install 'lumiere[denoise]'``."""
+itself), an optional dependency: ``pip install pyoidn``."""
 
 from __future__ import annotations
 
@@ -20,7 +20,7 @@ def _pyoidn() -> Any:
         import pyoidn
     except ImportError as e:
         raise ImportError(
-            "lumiere.denoise needs pyoidn (Intel Open Image Denoise): pip install 'lumiere[denoise]' or pip install pyoidn"
+            "lumiere.denoise needs pyoidn (Intel Open Image Denoise): pip install pyoidn"
         ) from e
     return pyoidn
 

@@ -177,8 +177,8 @@ impl Reader<'_> {
 }
 
 /// An option's value as a user names it, for the refusal's message: the technique's record
-/// (`AmbientOcclusion(AmbientOcclusion { samples: 2, distance: inf })`) as its flags
-/// (`--mode ao --samples 2 --ao-distance inf`; settings no flag sets, in parentheses), the
+/// (`AmbientOcclusion(AmbientOcclusion { samples: 2, distance: 0.5 })`) as its flags
+/// (`--mode ao --samples 2 --ao-distance 0.5`; settings no flag sets, in parentheses), the
 /// sampler's as its `--sampler` name.
 /// Anything else, or a description from another version that does not parse, stays as written.
 /// Only the message is reworded: the description itself keeps the records' Debug text, since it
@@ -203,6 +203,8 @@ fn readable(key: &str, value: &str) -> String {
                 match name {
                     "samples" => flags += &format!(" --samples {value}"),
                     "light_sampling" => flags += &format!(" --light-sampling {value}"),
+                    // No limit, the default, is no flag (`--ao-distance` takes finite values).
+                    "distance" if value == "inf" => {}
                     "distance" => flags += &format!(" --ao-distance {value}"),
                     "max_depth" => flags += &format!(" --max-depth {value}"),
                     _ => others.push(format!("{} {value}", name.replace('_', "-"))),

@@ -119,10 +119,16 @@ fn differing_options_name_each_key_once_with_both_values() {
             "technique: Direct(Direct { samples: 16, light_sampling: PerLight })\n",
             "technique: AmbientOcclusion(AmbientOcclusion { samples: 16, distance: inf })\n"
         ),
-        [
-            "technique (checkpoint: --mode direct --samples 16 --light-sampling per-light; now: --mode ao --samples 16 --ao-distance inf)"
-        ],
+        ["technique (checkpoint: --mode direct --samples 16 --light-sampling per-light; now: --mode ao --samples 16)"],
         "settings are named by their flags, with the flags' values"
+    );
+    assert_eq!(
+        differing_options(
+            "technique: AmbientOcclusion(AmbientOcclusion { samples: 4, distance: 0.5 })\n",
+            "technique: AmbientOcclusion(AmbientOcclusion { samples: 4, distance: inf })\n"
+        ),
+        ["technique (checkpoint: --mode ao --samples 4 --ao-distance 0.5; now: --mode ao --samples 4)"],
+        "no distance limit is no --ao-distance, which takes finite values only"
     );
 }
 

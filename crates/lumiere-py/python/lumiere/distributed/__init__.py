@@ -11,7 +11,7 @@ would not: floating-point addition is not associative.)
     >>> import lumiere, lumiere.distributed
     >>> image = lumiere.distributed.render(lumiere.builtin(), spp=64, address="auto")
 
-Needs Ray: ``pip install 'lumiere[ray]'``. See docs/DISTRIBUTED.md for measurements.
+Needs Ray: ``pip install ray``. See docs/DISTRIBUTED.md for measurements.
 """
 
 from __future__ import annotations
@@ -61,7 +61,7 @@ def _ray() -> Any:
     try:
         import ray
     except ImportError as e:
-        raise ImportError("lumiere.distributed needs Ray: pip install 'lumiere[ray]' (or pip install ray)") from e
+        raise ImportError("lumiere.distributed needs Ray: pip install ray") from e
     return ray
 
 
@@ -78,7 +78,7 @@ def _check_reachable(address: str, timeout: float) -> None:
     except OSError as e:
         raise ClusterUnreachable(
             f"no Ray cluster reachable at {address}: {e.strerror or e}; start one with `ray start --head` "
-            "or pass address=None to start a local one"
+            "or pass address=None (`--address local` on the command line) to start a local one"
         ) from None
 
 
