@@ -1,4 +1,5 @@
-//! Helpers shared by the integration tests: a seeded RNG and mesh generators.
+//! Helpers shared by the integration tests: a seeded RNG, mesh generators, and the mean of
+//! independent estimates with its standard error.
 #![allow(dead_code)]
 
 use glam::{Vec2, Vec3};
@@ -43,6 +44,16 @@ impl TestRng {
             }
         }
     }
+}
+
+/// Mean and standard error of the mean of `estimate(seed)` over the seeds `0..seeds`, each an
+/// independent estimate (an image's value or mean at that seed).
+pub fn mean_and_error<T: Into<f64>>(seeds: u64, mut estimate: impl FnMut(u64) -> T) -> (f64, f64) {
+    let values: Vec<f64> = (0..seeds).map(|seed| estimate(seed).into()).collect();
+    let n = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    let variance = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (mean, (variance / n).sqrt())
 }
 
 /// A closed cube `[-1, 1]^3` whose faces are `n x n` grids of quads (two triangles each), sharing

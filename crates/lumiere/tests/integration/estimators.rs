@@ -12,6 +12,8 @@ use lumiere::scene::camera::Camera;
 use lumiere::scene::mesh::{NO_INDEX, TriangleMesh};
 use lumiere::world::World;
 
+use crate::common::mean_and_error;
+
 /// Builds a scene from quads `(corners, material)`, each split into two triangles `(a,b,c), (a,c,d)`.
 fn scene_of_quads(quads: &[([Vec3; 4], usize)], materials: Vec<Material>) -> World {
     world_of(mesh_of_quads(quads), materials)
@@ -53,15 +55,6 @@ fn horizontal(y: f32, s: f32, down: bool) -> [Vec3; 4] {
 fn estimate(world: &World, eye: Vec3, target: Vec3, options: &RenderOptions) -> f32 {
     let camera = Camera::look_at(eye, target, Vec3::Y, 1.0, 1, 1).unwrap();
     render(world, &camera, options, &|_| {}).unwrap().image.pixels[0].x
-}
-
-/// Mean and standard error of the mean over `seeds` independent estimates.
-fn mean_and_error(seeds: u64, mut f: impl FnMut(u64) -> f32) -> (f64, f64) {
-    let values: Vec<f64> = (0..seeds).map(|s| f(s) as f64).collect();
-    let n = values.len() as f64;
-    let mean = values.iter().sum::<f64>() / n;
-    let variance = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
-    (mean, (variance / n).sqrt())
 }
 
 fn ao_options(samples: u32, seed: u64) -> RenderOptions {

@@ -12,15 +12,7 @@ use lumiere::scene::camera::Camera;
 use lumiere::scene::mesh::TriangleMesh;
 use lumiere::world::World;
 
-/// Mean over pixels and seeds, and the standard error of that mean from the spread of the
-/// per-seed means.
-fn mean_and_error(seeds: u64, mut image_mean: impl FnMut(u64) -> f64) -> (f64, f64) {
-    let values: Vec<f64> = (0..seeds).map(&mut image_mean).collect();
-    let n = values.len() as f64;
-    let mean = values.iter().sum::<f64>() / n;
-    let variance = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
-    (mean, (variance / n).sqrt())
-}
+use crate::common::mean_and_error;
 
 fn path(max_depth: u32, strategy: PathStrategy) -> Technique {
     Technique::Path(Path { max_depth, strategy, ..Path::default() })
