@@ -261,12 +261,15 @@ def test_an_edited_scene_file_renders_again_and_a_stale_one_is_named(cluster, tm
 
 
 def test_the_command_line_writes_the_cli_bytes(cluster, cli, tmp_path):
-    args = ["--size", "40x30", "--spp", "4", "--mode", "ao", "--samples", "2"]
-    cli("render", *args, "-o", tmp_path / "cli.pfm")
-    command = [sys.executable, "-m", "lumiere.distributed", "render", *args, "--address", cluster.address,
-               "-o", str(tmp_path / "ray.pfm")]
-    subprocess.run(command, check=True, capture_output=True, timeout=120)
-    assert (tmp_path / "ray.pfm").read_bytes() == (tmp_path / "cli.pfm").read_bytes()
+    ao = ["--size", "40x30", "--spp", "4", "--mode", "ao", "--samples", "2"]
+    # A PNG of the path tracer with the tone mapping that is not its default.
+    path = ["--size", "40x30", "--spp", "4", "--mode", "path", "--tonemap", "clamp", "--exposure", "1"]
+    for args, name in ((ao, "ao.pfm"), (path, "path.png")):
+        cli("render", *args, "-o", tmp_path / f"cli-{name}")
+        command = [sys.executable, "-m", "lumiere.distributed", "render", *args, "--address", cluster.address,
+                   "-o", str(tmp_path / f"ray-{name}")]
+        subprocess.run(command, check=True, capture_output=True, timeout=120)
+        assert (tmp_path / f"ray-{name}").read_bytes() == (tmp_path / f"cli-{name}").read_bytes(), name
 
 
 def test_a_clear_error_when_no_cluster_is_reachable(tmp_path):

@@ -62,6 +62,7 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--up", type=_floats, default=(0.0, 1.0, 0.0))
     p.add_argument("--fov", type=float, default=45.0)
     p.add_argument("--exposure", type=float, default=0.0, help="PNG exposure in stops")
+    p.add_argument("--tonemap", choices=["clamp", "aces"], help="PNG tone mapping (default aces for path, clamp otherwise)")
     p.add_argument("--tasks", type=int, help="tasks to split the passes into (default 4 per cluster CPU)")
     p.add_argument("--threads-per-task", type=int, default=1)
     p.add_argument("--max-retries", type=int, default=3, help="reruns of a task whose worker died (default 3)")
@@ -73,7 +74,8 @@ def parser() -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace) -> int:
     # Refused now, not once the render is done (`lumiere render` checks its output first too).
-    _lumiere.check_image_output(args.output, args.exposure, _tonemap(args.mode))
+    tonemap = args.tonemap or _tonemap(args.mode)
+    _lumiere.check_image_output(args.output, args.exposure, tonemap)
     if (args.eye is None) != (args.target is None):
         raise LumiereError("--eye and --target go together")
     twice = _first_repeat([name for name, _ in args.emission])
@@ -121,7 +123,7 @@ def run(args: argparse.Namespace) -> int:
         resume=args.resume,
         **technique,
     )
-    write_image(args.output, result.image, args.exposure, _tonemap(args.mode))
+    write_image(args.output, result.image, args.exposure, tonemap)
     stats = result.stats
     print(
         f"{args.output}: {camera.width}x{camera.height}, {stats['samples']} spp, {len(stats['tasks'])} tasks on "
