@@ -4,10 +4,13 @@
 
 use std::path::PathBuf;
 
-use lumiere::image_io::{PngEncoding, PngStyle, Tonemap, check_output_path, encode_image};
+use lumiere::image_io::{
+    ExrLayer, PngEncoding, PngStyle, Tonemap, check_output_path, encode_image, write_exr_with_layers,
+};
 use lumiere::render::checkpoint::Checkpoint;
 use lumiere::util::write::{check_writable, write_atomically};
 use pyo3::prelude::*;
+use pyo3::types::PyBytes;
 
 use crate::errors::{OrPyErr, invalid};
 use crate::files;
@@ -15,8 +18,11 @@ use crate::pixels::from_bytes;
 use crate::{pools, watch};
 
 /// Writes float32 RGB `pixels` (row 0 at the top) to `path`; the extension picks the format.
+/// AOVs, `(name, float32 RGB bytes)`, become the EXR's extra channels, as `lumiere render --aov`
+/// writes them.
 #[pyfunction]
-#[pyo3(signature = (path, width, height, pixels, exposure=0.0, tonemap="aces"))]
+#[pyo3(signature = (path, width, height, pixels, exposure=0.0, tonemap="aces", aovs=Vec::new()))]
+#[expect(clippy::too_many_arguments, reason = "Python's arguments, one each")]
 pub fn write_image(
     py: Python<'_>,
     path: PathBuf,
@@ -25,9 +31,28 @@ pub fn write_image(
     pixels: &[u8],
     exposure: f32,
     tonemap: &str,
+    aovs: Vec<(String, Bound<'_, PyBytes>)>,
 ) -> PyResult<()> {
     let style = png_style(exposure, tonemap)?;
-    let pixels = from_bytes(pixels, width as usize * height as usize, "image")?;
+    let count = width as usize * height as usize;
+    let pixels = from_bytes(pixels, count, "image")?;
+    if !aovs.is_empty() {
+        let names: Vec<String> = aovs.iter().map(|(name, _)| name.clone()).collect();
+        let kinds = crate::aovs::parse(&names)?;
+        let buffers =
+            aovs.iter().map(|(name, bytes)| from_bytes(bytes.as_bytes(), count, name)).collect::<PyResult<Vec<_>>>()?;
+        let layers: Vec<ExrLayer> = kinds
+            .iter()
+            .zip(&buffers)
+            .map(|(aov, pixels)| ExrLayer { name: aov.name(), channels: aov.exr_channels(), pixels })
+            .collect();
+        return py
+            .detach(|| {
+                files::tidy_beside(&path);
+                write_exr_with_layers(&path, width, height, &pixels, &layers)
+            })
+            .or_py();
+    }
     let pool = pools::for_background(py)?;
     // Encoding a large image takes seconds: Ctrl-C gives it up, as it gives up a load, and the
     // file stays as it was (the encoding ends in the background, its bytes dropped).

@@ -2,6 +2,7 @@
 //! library calls and back; the Python half (`python/lumiere/`) gives it the API a Python user
 //! expects (numpy arrays, keyword options, pickling for Ray), so each side does what it does best.
 
+mod aovs;
 mod camera;
 mod errors;
 mod files;
@@ -24,6 +25,8 @@ fn _lumiere(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_class::<options::PyOptions>()?;
     module.add_class::<film::PyFilm>()?;
     module.add_function(wrap_pyfunction!(render::render, module)?)?;
+    module.add_function(wrap_pyfunction!(aovs::aovs, module)?)?;
+    module.add_function(wrap_pyfunction!(aovs::check_aovs, module)?)?;
     module.add_function(wrap_pyfunction!(film::render_passes, module)?)?;
     module.add_function(wrap_pyfunction!(image::write_image, module)?)?;
     module.add_function(wrap_pyfunction!(image::check_image_output, module)?)?;

@@ -1,8 +1,8 @@
 //! `render`: a whole render on a pool of `threads`, with the GIL released (see `watch.rs`), and the
 //! AOVs asked for; returns the image and AOVs as float32 bytes and the render's statistics.
 
-use lumiere::render::aov::{Aov, render_aovs};
-use lumiere::render::film::{Film, check_memory};
+use lumiere::render::aov::render_aovs;
+use lumiere::render::film::Film;
 use lumiere::render::forecast::{NoiseForecast, shown_number};
 use lumiere::render::unlit::{Unlit, is_black, unlit, why_black};
 use lumiere::render::{Hooks, RenderStats, StopReason, render_progressive};
@@ -10,7 +10,6 @@ use pyo3::prelude::*;
 use pyo3::types::{PyByteArray, PyDict};
 
 use crate::camera::PyCamera;
-use crate::errors::OrPyErr;
 use crate::options::PyOptions;
 use crate::pixels::to_bytearray;
 use crate::pools;
@@ -32,14 +31,11 @@ pub fn render<'py>(
     progress: Option<Bound<'py, PyAny>>,
     stacklevel: i32,
 ) -> PyResult<Rendered<'py>> {
-    let aovs = aovs.iter().map(|name| Aov::parse(name)).collect::<lumiere::Result<Vec<_>>>().or_py()?;
+    let aovs = crate::aovs::parse(&aovs)?;
     // Owned by the render's thread (see `watch::run`).
     let (world, camera, options) = (scene.world.clone(), camera.camera.clone(), options.options.clone());
-    // As the CLI's check before rendering: each AOV's buffer and its bytes for numpy, and the
-    // image's bytes, beside the film (a huge image's AOVs aborted the interpreter once rendered).
-    if !aovs.is_empty() {
-        check_memory(camera.width, camera.height, aovs.len() as u64 * 24 + 12, " with its AOVs").or_py()?;
-    }
+    // Before rendering: a huge image's AOVs aborted the interpreter once rendered.
+    crate::aovs::check_fit(camera.width, camera.height, aovs.len())?;
     let pool = pools::for_render(py, threads)?;
     let threads = pool.current_num_threads();
     let pixels = u64::from(camera.width) * u64::from(camera.height);

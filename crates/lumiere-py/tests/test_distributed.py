@@ -77,6 +77,13 @@ def test_bytes_equal_a_local_render_whatever_the_split(cluster):
     local = lumiere.render(scene, camera, mode="direct", spp=5, samples=2)
     remote = distributed.render(scene, camera, mode="direct", spp=5, samples=2, address=cluster.address, tasks=3)
     assert np.array_equal(bits(remote), bits(local))
+    # With AOVs: the same dict, AOVs computed on the driver.
+    aovs = ("depth", "albedo", "normal")
+    local = lumiere.render(scene, camera, mode="ao", spp=3, samples=2, aovs=aovs)
+    remote = distributed.render(scene, camera, mode="ao", spp=3, samples=2, aovs=aovs, address=cluster.address)
+    assert list(remote) == list(local) == ["color", *aovs]
+    for name in local:
+        assert np.array_equal(bits(remote[name]), bits(local[name])), name
 
 
 def _render_processes():
@@ -264,7 +271,8 @@ def test_the_command_line_writes_the_cli_bytes(cluster, cli, tmp_path):
     ao = ["--size", "40x30", "--spp", "4", "--mode", "ao", "--samples", "2"]
     # A PNG of the path tracer with the tone mapping that is not its default.
     path = ["--size", "40x30", "--spp", "4", "--mode", "path", "--tonemap", "clamp", "--exposure", "1"]
-    for args, name in ((ao, "ao.pfm"), (path, "path.png")):
+    aovs = ["--size", "40x30", "--spp", "2", "--mode", "path", "--aov", "normal,depth,albedo"]
+    for args, name in ((ao, "ao.pfm"), (path, "path.png"), (aovs, "aovs.exr")):
         cli("render", *args, "-o", tmp_path / f"cli-{name}")
         command = [sys.executable, "-m", "lumiere.distributed", "render", *args, "--address", cluster.address,
                    "-o", str(tmp_path / f"ray-{name}")]
@@ -294,6 +302,9 @@ def test_the_command_line_refuses_its_output_and_camera_before_connecting(tmp_pa
         (["-o", str(tmp_path / "x.png"), "--eye", "0,1,3"], "--eye and --target go together"),
         (["-o", str(tmp_path / "x.png"), "--emission", "light.001=1,1,1", "--emission", "light.001=2,2,2"],
          "--emission 'light.001' is given twice"),
+        (["-o", str(tmp_path / "x.png"), "--aov", "albedo"], "x.png: --aov writes extra channels, which only an .exr"),
+        (["-o", str(tmp_path / "x.exr"), "--aov", "albedo,colour"], 'unknown AOV "colour"'),
+        (["-o", str(tmp_path / "x.exr"), "--aov", "depth,depth"], "aov 'depth' is given twice"),
     ):
         result = subprocess.run(base + extra, capture_output=True, text=True, timeout=120)
         assert result.returncode == 2, result.stderr

@@ -573,6 +573,29 @@ def test_write_image_writes_the_cli_bytes(cli, tmp_path):
         assert (tmp_path / f"py.{extension}").read_bytes() == (tmp_path / f"cli.{extension}").read_bytes(), extension
 
 
+def test_write_image_with_aovs_writes_the_cli_exr(cli, tmp_path):
+    cli("render", "--size", "32x24", "--spp", "3", "--aov", "depth,albedo,normal", "-o", tmp_path / "cli.exr")
+    out = lumiere.render(lumiere.builtin(), spp=3, size=(32, 24), aovs=("normal", "depth", "albedo"))
+    # The dict render returns, "color" and all: its AOVs become the EXR's channels.
+    lumiere.write_image(tmp_path / "py.exr", out["color"], aovs=out)
+    assert (tmp_path / "py.exr").read_bytes() == (tmp_path / "cli.exr").read_bytes()
+    # Without the AOVs, another file.
+    lumiere.write_image(tmp_path / "plain.exr", out["color"])
+    assert (tmp_path / "plain.exr").read_bytes() != (tmp_path / "cli.exr").read_bytes()
+    for aovs, error in (
+        ({"albedo": out["albedo"]}, r"png: extra layers \(AOVs\) need an .exr output"),
+        ({"colour": out["albedo"]}, 'unknown AOV "colour"'),
+        ({"depth": out["albedo"][:, :, 0:2]}, r"aovs\['depth'\] must have shape \(24, 32\) as the image, got \(24, 32, 2\)"),
+        ({"normal": out["normal"][:-1]}, r"aovs\['normal'\] must have shape \(24, 32, 3\) as the image, got \(23, 32, 3\)"),
+        ({"albedo": np.array([[["a"] * 3] * 32] * 24)}, r"aovs\['albedo'\] must hold numbers"),
+    ):
+        with pytest.raises(lumiere.LumiereError, match=error):
+            lumiere.write_image(tmp_path / ("x.png" if "png" in error else "x.exr"), out["color"], aovs=aovs)
+    with pytest.raises(TypeError, match="aovs must be a dict of arrays by AOV name, got list"):
+        lumiere.write_image(tmp_path / "x.exr", out["color"], aovs=["albedo"])
+    assert sorted(os.listdir(tmp_path)) == ["cli.exr", "plain.exr", "py.exr"]
+
+
 def test_a_render_that_comes_out_black_says_why(tmp_path):
     # As the CLI says it, in the package's words: no emitter, emitters that cannot emit, and an
     # image no camera ray lit; each a RuntimeWarning at the caller's line (they were silent).

@@ -39,28 +39,56 @@ __all__ = [
 ]
 
 
-def write_image(path: str, image: "object", exposure: float = 0.0, tonemap: str = "aces") -> None:
+def write_image(
+    path: str, image: "object", exposure: float = 0.0, tonemap: str = "aces", *, aovs: "object" = None
+) -> None:
     """Writes a ``(height, width, 3)`` float image as ``lumiere render -o`` does: ``.png``
-    (exposure, ``aces`` or ``clamp`` tone mapping, sRGB), ``.exr`` or ``.pfm`` (linear), atomically."""
+    (exposure, ``aces`` or ``clamp`` tone mapping, sRGB), ``.exr`` or ``.pfm`` (linear), atomically.
+
+    :param aovs: a dict of AOVs by name, as :func:`render` returns them (``albedo`` and ``normal``
+        of the image's shape, ``depth`` of its height and width; other keys, such as ``color``, are
+        left out): the extra channels of an ``.exr``, as ``lumiere render --aov`` writes them.
+    """
     import numpy as np
 
-    values = np.asarray(image)
-    # Numbers only: an object array's None (or a string of digits) would be converted silently,
-    # None to NaN, and written.
-    if values.dtype.kind not in "buif":
-        raise LumiereError(f"image must hold numbers, got an array of {values.dtype}")
-    # Values beyond float32 become infinities, as the CLI's would: numpy's overflow warning would
-    # point at this line, not the caller's.
-    with np.errstate(over="ignore"):
-        array = np.ascontiguousarray(values, dtype=np.float32)
+    array = _float32_array(image, "image")
     if array.ndim != 3 or array.shape[2] != 3:
         raise LumiereError(f"image must have shape (height, width, 3), got {array.shape}")
     height, width = array.shape[:2]
     # A side the writers' u32 cannot hold (an empty array can have one) is an error, not an overflow.
     if max(width, height) > 2**32 - 1:
         raise LumiereError(f"image size {width}x{height} is too large: at most 4294967295 pixels a side")
-    _write_image(_path(path), width, height, array.tobytes(), _float32(exposure, "exposure"), _text(tonemap, "tonemap"))
+    layers = []
+    if aovs is not None:
+        if not isinstance(aovs, dict):
+            raise TypeError(f"aovs must be a dict of arrays by AOV name, got {type(aovs).__name__}")
+        for name in _aov_names([name for name in aovs if name != "color"]):
+            layer = _float32_array(aovs[name], f"aovs[{name!r}]")
+            # A depth is one number a pixel; the writer reads the first of three.
+            if name == "depth" and layer.shape == (height, width):
+                layer = np.repeat(layer[:, :, None], 3, axis=2)
+            if layer.shape != (height, width, 3):
+                expected = f"({height}, {width})" if name == "depth" else f"({height}, {width}, 3)"
+                raise LumiereError(f"aovs[{name!r}] must have shape {expected} as the image, got {np.shape(aovs[name])}")
+            layers.append((name, layer.tobytes()))
+    exposure, tonemap = _float32(exposure, "exposure"), _text(tonemap, "tonemap")
+    _write_image(_path(path), width, height, array.tobytes(), exposure, tonemap, layers)
+
+
+def _float32_array(values: "object", what: str) -> "object":
+    import numpy as np
+
+    values = np.asarray(values)
+    # Numbers only: an object array's None (or a string of digits) would be converted silently,
+    # None to NaN, and written.
+    if values.dtype.kind not in "buif":
+        raise LumiereError(f"{what} must hold numbers, got an array of {values.dtype}")
+    # Values beyond float32 become infinities, as the CLI's would: numpy's overflow warning would
+    # point at this line, not the caller's.
+    with np.errstate(over="ignore"):
+        return np.ascontiguousarray(values, dtype=np.float32)
 
 
 from ._lumiere import write_image as _write_image  # noqa: E402
+from ._render import _aov_names  # noqa: E402
 from ._scene import _float32, _path, _text  # noqa: E402

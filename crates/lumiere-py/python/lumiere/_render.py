@@ -128,30 +128,41 @@ def render_full(
     _check_scene(scene)
     options = _options(mode, spp, seed, sampler, time, noise, technique_options)
     camera = _camera(scene, camera, size)
-    if isinstance(aovs, str):
-        aovs = (aovs,)
-    if aovs is None:
-        aovs = ()
+    aovs = _aov_names(aovs)
     _check_progress(progress)
-    try:
-        aovs = tuple(_text(aov, f"aovs[{index}]") for index, aov in enumerate(aovs))
-    except TypeError:
-        raise LumiereError(f"aovs must be a list of names (albedo, normal, depth), got {aovs!r}") from None
-    # An EXR cannot hold a channel twice, and the CLI refuses it: so does this.
-    twice = _first_repeat(aovs)
-    if twice is not None:
-        raise LumiereError(f"aov {twice!r} is given twice")
     # The warnings the render issues (a noise target out of reach) point at the user's call.
     image, buffers, stats = _lumiere.render(
         scene._native, camera._native, options, _threads(threads), list(aovs), progress, _stacklevel_outside()
     )
     height, width = camera.height, camera.width
-    outputs = {}
-    for name, buffer in zip(aovs, buffers):
+    return RenderResult(_array(image, height, width), _aov_arrays(aovs, buffers, height, width), stats)
+
+
+def _aov_names(aovs: Any) -> Tuple[str, ...]:
+    """The AOV names asked for (one name alone, or None for none), each once."""
+    if isinstance(aovs, str):
+        aovs = (aovs,)
+    if aovs is None:
+        aovs = ()
+    try:
+        names = tuple(_text(aov, f"aovs[{index}]") for index, aov in enumerate(aovs))
+    except TypeError:
+        raise LumiereError(f"aovs must be a list of names (albedo, normal, depth), got {aovs!r}") from None
+    # An EXR cannot hold a channel twice, and the CLI refuses it: so does this.
+    twice = _first_repeat(names)
+    if twice is not None:
+        raise LumiereError(f"aov {twice!r} is given twice")
+    return names
+
+
+def _aov_arrays(names: Sequence[str], buffers: Sequence[bytearray], height: int, width: int) -> Dict[str, np.ndarray]:
+    """The library's AOV buffers as arrays by name: depth is one number per pixel (the library
+    repeats it in three channels), the others three."""
+    arrays = {}
+    for name, buffer in zip(names, buffers):
         array = _array(buffer, height, width)
-        # Depth is one number per pixel (the library repeats it in three channels).
-        outputs[name] = array[:, :, 0].copy() if name == "depth" else array
-    return RenderResult(_array(image, height, width), outputs, stats)
+        arrays[name] = array[:, :, 0].copy() if name == "depth" else array
+    return arrays
 
 
 def render(

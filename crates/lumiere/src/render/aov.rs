@@ -43,6 +43,16 @@ impl Aov {
         }
     }
 
+    /// Its channels in an EXR, after the layer's name (`albedo.R`, `normal.X`, `depth.Z`): a
+    /// depth is one value, which the buffer repeats in its three components.
+    pub fn exr_channels(self) -> &'static [&'static str] {
+        match self {
+            Aov::Albedo => &["R", "G", "B"],
+            Aov::Normal => &["X", "Y", "Z"],
+            Aov::Depth => &["Z"],
+        }
+    }
+
     /// The AOV named `name` (`albedo`, `normal`, `depth`).
     pub fn parse(name: &str) -> Result<Aov> {
         [Aov::Albedo, Aov::Normal, Aov::Depth]

@@ -284,15 +284,7 @@ fn write_output(
     let mut layers: Vec<ExrLayer> = args
         .aov
         .iter()
-        .map(|&aov| ExrLayer {
-            name: aov.name(),
-            channels: match aov {
-                Aov::Albedo => &["R", "G", "B"],
-                Aov::Normal => &["X", "Y", "Z"],
-                Aov::Depth => &["Z"],
-            },
-            pixels: buffer(aov),
-        })
+        .map(|&aov| ExrLayer { name: aov.name(), channels: aov.exr_channels(), pixels: buffer(aov) })
         .collect();
     let exr = args.output.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
     if denoised.is_some() && exr {

@@ -22,12 +22,22 @@ import os
 import socket
 import time
 import uuid
-from typing import Any, Dict, List, Optional, Sequence, Set, Tuple
+from typing import Any, Dict, List, Optional, Sequence, Set, Tuple, Union
 
 import numpy as np
 
 from .. import _lumiere
-from .._render import Progress, RenderResult, _array, _camera, _check_progress, _check_scene, _options
+from .._render import (
+    Progress,
+    RenderResult,
+    _aov_arrays,
+    _aov_names,
+    _array,
+    _camera,
+    _check_progress,
+    _check_scene,
+    _options,
+)
 from .._scene import Camera, Scene, _integer, _path, _rebuild_camera, _rebuild_scene
 from ..errors import LumiereError
 
@@ -315,11 +325,14 @@ def render_full(
     checkpoint_every: float = 60.0,
     resume: bool = False,
     progress: Optional[Progress] = None,
+    aovs: Sequence[str] = (),
     **technique_options: Any,
 ) -> RenderResult:
-    """Like :func:`render`, returning the image and statistics (``tasks``: per task its first
-    pass, passes, worker wall and CPU seconds, host and pid; ``seconds``: the driver's wall time)."""
+    """Like :func:`render`, returning the image, the AOVs and the statistics (``tasks``: per task
+    its first pass, passes, worker wall and CPU seconds, host and pid; ``seconds``: the driver's
+    wall time, AOVs included)."""
     _check_scene(scene)
+    aovs = _aov_names(aovs)
     if spp is None:
         raise LumiereError("spp must be given: a distributed render does a fixed number of passes")
     spp = _integer(spp, "spp", 1)
@@ -343,6 +356,7 @@ def render_full(
     # What each worker builds its options from: the values `_options` accepted.
     option_args = dict(mode=mode, spp=spp, seed=seed, sampler=sampler, **technique_options)
     camera = _camera(scene, camera, size)
+    _lumiere.check_aovs(camera.width, camera.height, list(aovs))
     if checkpoint is not None:
         _check_outputs([("checkpoint", checkpoint)], scene, "scene", camera, "camera")
         # Refused now, not once the render is done and the checkpoint cannot hold it; after the
@@ -412,9 +426,11 @@ def render_full(
             with contextlib.suppress(Exception):
                 abandonments.abandon.remote(render)
         raise
-    seconds = time.perf_counter() - start
     if checkpoint is not None:
         save()
+    # First hits only, a pass cheap beside the image's: computed here, on every core of this machine.
+    buffers = _lumiere.aovs(scene._native, camera._native, options, 0, list(aovs)) if aovs else []
+    seconds = time.perf_counter() - start
     stats = {
         "samples": film.samples,
         "rays": film.rays,
@@ -424,7 +440,7 @@ def render_full(
         "tasks": records,
         "cpus": cpus,
     }
-    return RenderResult(_array(film.image(), height, width), {}, stats)
+    return RenderResult(_array(film.image(), height, width), _aov_arrays(aovs, buffers, height, width), stats)
 
 
 def render(
@@ -444,10 +460,11 @@ def render(
     checkpoint_every: float = 60.0,
     resume: bool = False,
     progress: Optional[Progress] = None,
+    aovs: Sequence[str] = (),
     **technique_options: Any,
-) -> np.ndarray:
-    """Renders on a Ray cluster; returns the array :func:`lumiere.render` returns for the same
-    scene, camera and options, bit for bit.
+) -> Union[np.ndarray, Dict[str, np.ndarray]]:
+    """Renders on a Ray cluster; returns what :func:`lumiere.render` returns for the same scene,
+    camera and options (the array, or with ``aovs`` the dict of it and its AOVs), bit for bit.
 
     :param address: the cluster (see :func:`connect`); None starts a local Ray instance.
     :param tasks: how many tasks to split the passes into (default 4 per CPU of the cluster; more
@@ -459,11 +476,13 @@ def render(
     :param resume: continue from ``checkpoint`` when it exists (same scene and options; more
         ``spp`` is fine); needs ``checkpoint``.
     :param progress: ``progress(done, total)`` in pixel samples, as passes are merged.
+    :param aovs: names among ``albedo``, ``normal``, ``depth``, computed on this machine once the
+        passes are merged (a pass of first hits, cheap beside the image's).
 
     Budgets (``time``, ``noise``) are not offered: a distributed render does a fixed number of
     passes. The other parameters are :func:`lumiere.render`'s.
     """
-    return render_full(
+    result = render_full(
         scene,
         camera,
         mode,
@@ -479,5 +498,9 @@ def render(
         checkpoint_every=checkpoint_every,
         resume=resume,
         progress=progress,
+        aovs=aovs,
         **technique_options,
-    ).image
+    )
+    if not result.aovs and not aovs:
+        return result.image
+    return {"color": result.image, **result.aovs}

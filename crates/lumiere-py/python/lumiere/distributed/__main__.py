@@ -32,6 +32,10 @@ def _size(text: str) -> tuple:
     return (width, height)
 
 
+def _names(text: str) -> List[str]:
+    return [name.strip() for name in text.split(",")]
+
+
 def _emission(text: str) -> tuple:
     name, _, value = text.rpartition("=")
     if not name:
@@ -63,6 +67,8 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--fov", type=float, default=45.0)
     p.add_argument("--exposure", type=float, default=0.0, help="PNG exposure in stops")
     p.add_argument("--tonemap", choices=["clamp", "aces"], help="PNG tone mapping (default aces for path, clamp otherwise)")
+    p.add_argument("--aov", type=_names, default=[], metavar="albedo,normal,depth",
+                   help="extra EXR channels: first-hit colour, shading normal, distance (computed here)")
     p.add_argument("--tasks", type=int, help="tasks to split the passes into (default 4 per cluster CPU)")
     p.add_argument("--threads-per-task", type=int, default=1)
     p.add_argument("--max-retries", type=int, default=3, help="reruns of a task whose worker died (default 3)")
@@ -76,6 +82,8 @@ def run(args: argparse.Namespace) -> int:
     # Refused now, not once the render is done (`lumiere render` checks its output first too).
     tonemap = args.tonemap or _tonemap(args.mode)
     _lumiere.check_image_output(args.output, args.exposure, tonemap)
+    if args.aov and not args.output.lower().endswith(".exr"):
+        raise LumiereError(f"{args.output}: --aov writes extra channels, which only an .exr output can hold")
     if (args.eye is None) != (args.target is None):
         raise LumiereError("--eye and --target go together")
     twice = _first_repeat([name for name, _ in args.emission])
@@ -121,9 +129,10 @@ def run(args: argparse.Namespace) -> int:
         checkpoint=args.checkpoint,
         checkpoint_every=args.checkpoint_every,
         resume=args.resume,
+        aovs=args.aov,
         **technique,
     )
-    write_image(args.output, result.image, args.exposure, tonemap)
+    write_image(args.output, result.image, args.exposure, tonemap, aovs=result.aovs)
     stats = result.stats
     print(
         f"{args.output}: {camera.width}x{camera.height}, {stats['samples']} spp, {len(stats['tasks'])} tasks on "
