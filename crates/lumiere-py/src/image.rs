@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use lumiere::image_io::{
-    ExrLayer, PngEncoding, PngStyle, Tonemap, check_output_path, encode_image, write_exr_with_layers,
+    ExrLayer, NOISY_LAYER, PngEncoding, PngStyle, Tonemap, check_output_path, encode_image, write_exr_with_layers,
 };
 use lumiere::render::checkpoint::Checkpoint;
 use lumiere::util::write::{check_writable, write_atomically};
@@ -19,7 +19,7 @@ use crate::{pools, watch};
 
 /// Writes float32 RGB `pixels` (row 0 at the top) to `path`; the extension picks the format.
 /// AOVs, `(name, float32 RGB bytes)`, become the EXR's extra channels, as `lumiere render --aov`
-/// writes them.
+/// writes them (and `noisy`, as `--denoise` does).
 #[pyfunction]
 #[pyo3(signature = (path, width, height, pixels, exposure=0.0, tonemap="aces", aovs=Vec::new()))]
 #[expect(clippy::too_many_arguments, reason = "Python's arguments, one each")]
@@ -37,14 +37,14 @@ pub fn write_image(
     let count = width as usize * height as usize;
     let pixels = from_bytes(pixels, count, "image")?;
     if !aovs.is_empty() {
-        let names: Vec<String> = aovs.iter().map(|(name, _)| name.clone()).collect();
-        let kinds = crate::aovs::parse(&names)?;
+        let channels = aovs.iter().map(|(name, _)| layer_channels(name)).collect::<PyResult<Vec<_>>>()?;
         let buffers =
             aovs.iter().map(|(name, bytes)| from_bytes(bytes.as_bytes(), count, name)).collect::<PyResult<Vec<_>>>()?;
-        let layers: Vec<ExrLayer> = kinds
+        let layers: Vec<ExrLayer> = aovs
             .iter()
+            .zip(channels)
             .zip(&buffers)
-            .map(|(aov, pixels)| ExrLayer { name: aov.name(), channels: aov.exr_channels(), pixels })
+            .map(|(((name, _), channels), pixels)| ExrLayer { name, channels, pixels })
             .collect();
         return py
             .detach(|| {
@@ -66,6 +66,15 @@ pub fn write_image(
         write_atomically(&path, &bytes)
     })
     .or_py()
+}
+
+/// The EXR channels of the layer `name`: an AOV's, or RGB for `noisy`, the image before
+/// denoising that `lumiere render --denoise` keeps beside the denoised one.
+fn layer_channels(name: &str) -> PyResult<&'static [&'static str]> {
+    if name == NOISY_LAYER {
+        return Ok(&["R", "G", "B"]);
+    }
+    Ok(crate::aovs::parse(&[name.to_string()])?[0].exr_channels())
 }
 
 /// Refuses, before a long render, an image output that [`write_image`] would refuse after it: a

@@ -280,6 +280,20 @@ def test_the_command_line_writes_the_cli_bytes(cluster, cli, tmp_path):
         assert (tmp_path / f"ray-{name}").read_bytes() == (tmp_path / f"cli-{name}").read_bytes(), name
 
 
+def test_the_command_line_denoises_as_the_cli_does(cluster, cli, tmp_path, monkeypatch):
+    optional("pyoidn", "pip install pyoidn")
+    # The CLI loads OIDN from the pyoidn that `python3` imports: this interpreter's.
+    monkeypatch.setenv("PATH", os.path.dirname(sys.executable) + os.pathsep + os.environ["PATH"])
+    # The EXR holds the denoised image, the depth AOV and the noisy image.
+    for extra, name in ((["--aov", "depth"], "x.exr"), ([], "x.png")):
+        args = ["--size", "40x30", "--spp", "4", "--denoise", *extra]
+        cli("render", *args, "-o", tmp_path / f"cli-{name}")
+        command = [sys.executable, "-m", "lumiere.distributed", "render", *args, "--address", cluster.address,
+                   "-o", str(tmp_path / f"ray-{name}")]
+        subprocess.run(command, check=True, capture_output=True, timeout=120)
+        assert (tmp_path / f"ray-{name}").read_bytes() == (tmp_path / f"cli-{name}").read_bytes(), name
+
+
 def test_a_clear_error_when_no_cluster_is_reachable(tmp_path):
     # A port nothing listens on (the process must not be connected already, hence a subprocess).
     command = [sys.executable, "-m", "lumiere.distributed", "render", "--address", "127.0.0.1:9", "--spp", "1",

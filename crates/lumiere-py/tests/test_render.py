@@ -588,6 +588,7 @@ def test_write_image_with_aovs_writes_the_cli_exr(cli, tmp_path):
         ({"depth": out["albedo"][:, :, 0:2]}, r"aovs\['depth'\] must have shape \(24, 32\) as the image, got \(24, 32, 2\)"),
         ({"normal": out["normal"][:-1]}, r"aovs\['normal'\] must have shape \(24, 32, 3\) as the image, got \(23, 32, 3\)"),
         ({"albedo": np.array([[["a"] * 3] * 32] * 24)}, r"aovs\['albedo'\] must hold numbers"),
+        ({"noisy": out["depth"]}, r"aovs\['noisy'\] must have shape \(24, 32, 3\) as the image, got \(24, 32\)"),
     ):
         with pytest.raises(lumiere.LumiereError, match=error):
             lumiere.write_image(tmp_path / ("x.png" if "png" in error else "x.exr"), out["color"], aovs=aovs)

@@ -309,6 +309,9 @@ fn encode_exr(path: &Path, width: u32, height: u32, pixels: &[Vec3]) -> Result<V
     Ok(cursor.into_inner())
 }
 
+/// The name of the EXR layer that holds the image before denoising, beside the denoised one.
+pub const NOISY_LAYER: &str = "noisy";
+
 /// One set of extra channels of an EXR file: an arbitrary output (AOV) beside the image.
 #[derive(Clone, Copy, Debug)]
 pub struct ExrLayer<'a> {

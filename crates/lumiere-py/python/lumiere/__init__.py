@@ -46,8 +46,10 @@ def write_image(
     (exposure, ``aces`` or ``clamp`` tone mapping, sRGB), ``.exr`` or ``.pfm`` (linear), atomically.
 
     :param aovs: a dict of AOVs by name, as :func:`render` returns them (``albedo`` and ``normal``
-        of the image's shape, ``depth`` of its height and width; other keys, such as ``color``, are
-        left out): the extra channels of an ``.exr``, as ``lumiere render --aov`` writes them.
+        of the image's shape, ``depth`` of its height and width; ``color`` is left out): the extra
+        channels of an ``.exr``, as ``lumiere render --aov`` writes them. ``noisy`` (the image's
+        shape) is a layer of RGB channels, where ``lumiere render --denoise`` keeps the image
+        before denoising.
     """
     import numpy as np
 

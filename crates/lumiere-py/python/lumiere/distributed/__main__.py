@@ -8,7 +8,8 @@ import argparse
 import sys
 from typing import List, Optional
 
-from .. import Camera, LumiereError, _lumiere, builtin, load, write_image
+from .. import Camera, LumiereError, _lumiere, builtin, denoise, load, write_image
+from .._denoise import _pyoidn
 from .._scene import _first_repeat
 from . import ClusterUnreachable, TaskFailed, _check_outputs, render_full
 
@@ -69,6 +70,8 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--tonemap", choices=["clamp", "aces"], help="PNG tone mapping (default aces for path, clamp otherwise)")
     p.add_argument("--aov", type=_names, default=[], metavar="albedo,normal,depth",
                    help="extra EXR channels: first-hit colour, shading normal, distance (computed here)")
+    p.add_argument("--denoise", action="store_true",
+                   help="denoise with OIDN (pyoidn) here, with the albedo and normal AOVs; an .exr keeps the noisy image as the layer noisy")
     p.add_argument("--tasks", type=int, help="tasks to split the passes into (default 4 per cluster CPU)")
     p.add_argument("--threads-per-task", type=int, default=1)
     p.add_argument("--max-retries", type=int, default=3, help="reruns of a task whose worker died (default 3)")
@@ -82,8 +85,11 @@ def run(args: argparse.Namespace) -> int:
     # Refused now, not once the render is done (`lumiere render` checks its output first too).
     tonemap = args.tonemap or _tonemap(args.mode)
     _lumiere.check_image_output(args.output, args.exposure, tonemap)
-    if args.aov and not args.output.lower().endswith(".exr"):
+    exr = args.output.lower().endswith(".exr")
+    if args.aov and not exr:
         raise LumiereError(f"{args.output}: --aov writes extra channels, which only an .exr output can hold")
+    if args.denoise:
+        _pyoidn()  # Its absence is an error now, not once the render is done.
     if (args.eye is None) != (args.target is None):
         raise LumiereError("--eye and --target go together")
     twice = _first_repeat([name for name, _ in args.emission])
@@ -129,10 +135,16 @@ def run(args: argparse.Namespace) -> int:
         checkpoint=args.checkpoint,
         checkpoint_every=args.checkpoint_every,
         resume=args.resume,
-        aovs=args.aov,
+        aovs=args.aov + [name for name in ("albedo", "normal") if args.denoise and name not in args.aov],
         **technique,
     )
-    write_image(args.output, result.image, args.exposure, tonemap, aovs=result.aovs)
+    image, layers = result.image, {name: result.aovs[name] for name in args.aov}
+    # As `lumiere render --denoise`: the same filter on the same AOVs, the noisy image kept in an EXR.
+    if args.denoise:
+        image = denoise(result.image, result.aovs["albedo"], result.aovs["normal"])
+        if exr:
+            layers["noisy"] = result.image
+    write_image(args.output, image, args.exposure, tonemap, aovs=layers)
     stats = result.stats
     print(
         f"{args.output}: {camera.width}x{camera.height}, {stats['samples']} spp, {len(stats['tasks'])} tasks on "
