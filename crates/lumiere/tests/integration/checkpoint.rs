@@ -5,10 +5,10 @@
 use std::path::Path;
 
 use glam::Vec3;
-use lumiere::integrators::Technique;
+use lumiere::integrators::{AmbientOcclusion, Hits, Materials, Shadows, Technique};
 use lumiere::render::checkpoint::{Checkpoint, differing_options};
 use lumiere::render::film::{Film, PassSamples};
-use lumiere::render::fingerprint::{Fingerprints, Mismatch};
+use lumiere::render::fingerprint::{Fingerprints, Mismatch, options_description};
 use lumiere::render::{RenderOptions, RenderStats};
 use lumiere::sampler::SamplerKind;
 use lumiere::scene::builtin;
@@ -85,6 +85,16 @@ fn size_fields_that_do_not_match_the_bytes_are_refused() {
     assert!(error.contains("(its size does not match its pixel data)"), "{error}");
 }
 
+/// A file one byte short of a header and its checksum is refused as having no header, even with a
+/// valid checksum (a forged file, or one cut short and sealed by a bug): its fields are never read
+/// past its end, nor blamed on its pixel data.
+#[test]
+fn a_file_shorter_than_a_header_has_no_header() {
+    let bytes = checkpoint(3, 2, "seed: 3\n").encode().unwrap();
+    let error = decode_error(&sealed(bytes[..HEADER - 1].to_vec()));
+    assert!(error.contains("render.ckpt: not a valid lumiere checkpoint (no checkpoint header)"), "{error}");
+}
+
 /// The options text is bounded (64 KiB) for hostile files: the bound itself is accepted.
 #[test]
 fn options_text_up_to_its_bound_is_kept() {
@@ -130,6 +140,26 @@ fn differing_options_name_each_key_once_with_both_values() {
         ["technique (checkpoint: --mode ao --samples 4 --ao-distance 0.5; now: --mode ao --samples 4)"],
         "no distance limit is no --ao-distance, which takes finite values only"
     );
+}
+
+/// A refused resume names every technique by its `--mode` flag, read from the Debug text that a
+/// checkpoint's options description holds (`Materials(Materials)` is `--mode materials`).
+#[test]
+fn every_technique_is_named_by_its_mode_flag() {
+    let camera = Camera::from_orbiter(&builtin::cornell_orbiter().unwrap(), 3, 2);
+    let description = |technique| options_description(&RenderOptions::new(technique), &camera);
+    let ao = Technique::AmbientOcclusion(AmbientOcclusion { samples: 2, distance: 0.5 });
+    for (technique, flags) in [
+        (Technique::Materials(Materials), "--mode materials"),
+        (Technique::Shadows(Shadows), "--mode shadows"),
+        (Technique::direct(4), "--mode direct --samples 4 --light-sampling per-light"),
+        (ao, "--mode ao --samples 2 --ao-distance 0.5"),
+    ] {
+        assert_eq!(
+            differing_options(&description(technique), &description(Technique::Hits(Hits))),
+            [format!("technique (checkpoint: {flags}; now: --mode hits)")]
+        );
+    }
 }
 
 /// Values are quoted up to 120 characters; longer ones (the camera's matrices) are only said to

@@ -549,3 +549,31 @@ fn the_scene_fingerprint_holds_the_texture_files_bytes() {
         assert!(all[i + 1..].iter().all(|b| a != b), "{all:x?}");
     }
 }
+
+/// A texture's placement (`-s`, `-o`) is part of the scene's fingerprint: a render of tiles
+/// placed one way does not resume with them placed another. The identity placement, written out
+/// or not, is the same scene, so that the fingerprints of scenes without placements (and their
+/// checkpoints) stay what they were.
+#[test]
+fn the_scene_fingerprint_holds_the_texture_placements() {
+    let dir = TempDir::new("fingerprint-placements");
+    test_image().save_with_format(dir.path("wood.png"), ImageFormat::Png).unwrap();
+    let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl wood\nf 1/1 2/2 3/3\n";
+    let scene = dir.write("s.obj", obj);
+    let fingerprint = |map_kd: &str, map_d: &str| {
+        dir.write("m.mtl", format!("newmtl wood\nmap_Kd {map_kd}wood.png\nmap_d {map_d}wood.png\n"));
+        scene_fingerprint(&World::new(Scene::load(&scene).unwrap(), Default::default()))
+    };
+    let plain = fingerprint("", "");
+    assert_eq!(fingerprint("-s 1 1 1 -o 0 0 0 ", "-s 1 1 -o 0 0 "), plain, "the identity placement written out");
+    let placed = [
+        plain,
+        fingerprint("-s 2 2 1 ", ""),
+        fingerprint("-o 0.5 0 0 ", ""),
+        fingerprint("", "-s 2 2 1 "),
+        fingerprint("", "-o 0.5 0 0 "),
+    ];
+    for (i, a) in placed.iter().enumerate() {
+        assert!(placed[i + 1..].iter().all(|b| a != b), "{placed:x?}");
+    }
+}
