@@ -12,6 +12,7 @@ use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::materials::Bsdf;
+use crate::math::Ray;
 use crate::render::RenderOptions;
 use crate::render::camera_sample;
 use crate::sampler::Sampler;
@@ -87,12 +88,21 @@ pub fn render_aovs(
             }
             (0..width)
                 .map(|x| {
+                    // A pixel's samples are one packet: their rays leave one point for one pixel,
+                    // so they walk the BVH together, with the hits and surface points of rays
+                    // traced one at a time, bit for bit. One at a time, the AOVs of the built-in
+                    // box (1024x768, 16 samples, 1 thread) took 2.7 s instead of 1.9.
+                    let mut rays = [Ray::new(Vec3::ZERO, Vec3::Z); AOV_SAMPLES as usize];
+                    for (sample, ray) in rays.iter_mut().enumerate().take(samples as usize) {
+                        *ray = camera_sample(camera, &sampler, (x, y), sample as u32, centre).0;
+                    }
+                    let live = (1u32 << samples) - 1;
+                    let found = world.intersect_packet(&rays, live);
+                    let surfaces = world.surfaces(&rays, &found);
                     let (mut sum, mut hits) = ([Vec3::ZERO; 3], 0u32);
-                    for sample in 0..samples {
-                        let (ray, _) = camera_sample(camera, &sampler, (x, y), sample, centre);
-                        let Some(hit) = world.intersect(&ray) else { continue };
-                        let surface = world.surface(&ray, &hit);
-                        sum[0] += world.bsdf(&surface).albedo();
+                    for ((ray, hit), surface) in rays.iter().zip(&found).zip(&surfaces) {
+                        let Some(hit) = hit else { continue };
+                        sum[0] += world.bsdf(surface).albedo();
                         sum[1] += surface.ns;
                         sum[2] += Vec3::splat(hit.t * ray.dir.length());
                         hits += 1;
