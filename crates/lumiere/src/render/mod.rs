@@ -41,7 +41,7 @@ use crate::sampler::Sampler;
 use crate::scene::camera::Camera;
 use crate::world::World;
 use film::{Film, Image};
-pub(crate) use pass::camera_sample;
+pub(crate) use pass::film_position;
 use pass::{Pass, pass_buffer, render_pass};
 
 /// Why a render stopped.

@@ -12,7 +12,6 @@ use super::film::out_of_memory;
 use crate::accel::OriginBatch;
 use crate::error::Result;
 use crate::integrators::{CameraPacket, Integrator, PACKET, SampleContext};
-use crate::math::Ray;
 use crate::sampler::{SampleStream, Sampler};
 use crate::scene::camera::Camera;
 use crate::util::memory::{ask_for_huge_pages, try_zeroed_vec};
@@ -47,23 +46,12 @@ pub(super) fn pass_buffer(width: u32, height: u32) -> Result<Vec<[f32; 3]>> {
     Ok(buffer)
 }
 
-/// The camera ray of sample `sample` of pixel `(x, y)`, and that sample's random numbers with the
-/// pixel position already drawn from their first dimension (drawn even for pixel centres, so that
-/// the integrator's dimensions do not depend on it). The one place a sample's position is decided:
-/// the render and its AOVs go through it, so they line up.
-pub(crate) fn camera_sample<'a>(
-    camera: &Camera,
-    sampler: &'a Sampler,
-    pixel: (u32, u32),
-    sample: u32,
-    pixel_centre: bool,
-) -> (Ray, SampleStream<'a>) {
-    let (position, stream) = film_position(camera, sampler, pixel, sample, pixel_centre);
-    (camera.ray(position.x, position.y), stream)
-}
-
-/// The film position of [`camera_sample`] (whose ray [`Camera::rays`] gives for many at once).
-fn film_position<'a>(
+/// The film position of sample `sample` of pixel `(x, y)` (its camera ray is `Camera::ray` there,
+/// or `Camera::rays` for many), and that sample's random numbers with the position already drawn
+/// from their first dimension (drawn even for pixel centres, so that the integrator's dimensions do
+/// not depend on it). The one place a sample's position is decided: the render and its AOVs go
+/// through it, so they line up.
+pub(crate) fn film_position<'a>(
     camera: &Camera,
     sampler: &'a Sampler,
     (x, y): (u32, u32),
