@@ -442,6 +442,20 @@ fn broken_mtl_lines_warn_and_the_rest_is_kept() {
     assert_eq!(material_of(&scene, 0).ke, Vec3::ZERO);
 }
 
+/// Emitted radiance cannot be negative (light is not taken away, and a negative weight would
+/// upset the choice of lights in proportion to their power): a `Ke` with a negative component is
+/// refused with a warning that names it, while zero components, and the black `Ke` exporters write
+/// on every surface that is no light, are read without a word.
+#[test]
+fn a_negative_emission_is_refused_and_zero_components_are_read() {
+    let mtl = "newmtl dark\nKe 0 0 0\nnewmtl red\nKe 4 0 0\nnewmtl sink\nKe 1 -0.5 1\n";
+    let scene = parse_with(&format!("mtllib m.mtl\n{SQUARE}f 1 2 3\n"), &[("m.mtl", mtl)]);
+    // The face comes before any `usemtl`: the fourth material is the default one.
+    let [dark, red, sink, _] = &scene.materials[..] else { panic!("{:?}", scene.materials) };
+    assert_eq!((dark.ke, red.ke, sink.ke), (Vec3::ZERO, Vec3::new(4.0, 0.0, 0.0), Vec3::ZERO));
+    assert_eq!(scene.warnings, ["mem/m.mtl:6: Ke must not be negative, found 1 -0.5 1; line ignored"]);
+}
+
 #[test]
 fn mtl_statements_and_texture_paths() {
     let dir = TempDir::new("mtl-statements");
