@@ -5,7 +5,8 @@
 use std::path::PathBuf;
 
 use lumiere::image_io::{
-    ExrLayer, NOISY_LAYER, PngEncoding, PngStyle, Tonemap, check_output_path, encode_image, write_exr_with_layers,
+    ExrLayer, NOISY_LAYER, PngEncoding, PngStyle, RGB_CHANNELS, Tonemap, check_output_path, encode_image,
+    write_exr_with_layers,
 };
 use lumiere::render::checkpoint::Checkpoint;
 use lumiere::util::write::{check_writable, write_atomically};
@@ -72,7 +73,7 @@ pub fn write_image(
 /// denoising that `lumiere render --denoise` keeps beside the denoised one.
 fn layer_channels(name: &str) -> PyResult<&'static [&'static str]> {
     if name == NOISY_LAYER {
-        return Ok(&["R", "G", "B"]);
+        return Ok(RGB_CHANNELS);
     }
     Ok(crate::aovs::parse(&[name.to_string()])?[0].exr_channels())
 }

@@ -312,6 +312,9 @@ fn encode_exr(path: &Path, width: u32, height: u32, pixels: &[Vec3]) -> Result<V
 /// The name of the EXR layer that holds the image before denoising, beside the denoised one.
 pub const NOISY_LAYER: &str = "noisy";
 
+/// The channels of a colour: the image's own, and those of a colour layer (`albedo`, `noisy`).
+pub const RGB_CHANNELS: &[&str] = &["R", "G", "B"];
+
 /// One set of extra channels of an EXR file: an arbitrary output (AOV) beside the image.
 #[derive(Clone, Copy, Debug)]
 pub struct ExrLayer<'a> {
@@ -334,7 +337,7 @@ pub fn write_exr_with_layers(path: &Path, width: u32, height: u32, pixels: &[Vec
     // Each layer's channels are copied out of their pixels before the file is encoded.
     let copies = 12 * (1 + layers.len() as u64);
     check_encoding_memory(path, width, height, Format::Exr.encoding_bytes_per_pixel() + copies)?;
-    let main = ExrLayer { name: "", channels: &["R", "G", "B"], pixels };
+    let main = ExrLayer { name: "", channels: RGB_CHANNELS, pixels };
     let mut channels = Vec::new();
     for layer in std::iter::once(&main).chain(layers) {
         check_dimensions(width, height, layer.pixels.len())?;

@@ -77,20 +77,6 @@ def write_image(
     _write_image(_path(path), width, height, array.tobytes(), exposure, tonemap, layers)
 
 
-def _float32_array(values: "object", what: str) -> "object":
-    import numpy as np
-
-    values = np.asarray(values)
-    # Numbers only: an object array's None (or a string of digits) would be converted silently,
-    # None to NaN, and written.
-    if values.dtype.kind not in "buif":
-        raise LumiereError(f"{what} must hold numbers, got an array of {values.dtype}")
-    # Values beyond float32 become infinities, as the CLI's would: numpy's overflow warning would
-    # point at this line, not the caller's.
-    with np.errstate(over="ignore"):
-        return np.ascontiguousarray(values, dtype=np.float32)
-
-
 from ._lumiere import write_image as _write_image  # noqa: E402
 from ._render import _aov_names  # noqa: E402
-from ._scene import _float32, _path, _text  # noqa: E402
+from ._scene import _float32, _float32_array, _path, _text  # noqa: E402

@@ -7,6 +7,7 @@ from typing import Any, Optional
 
 import numpy as np
 
+from ._scene import _float32_array
 from .errors import LumiereError
 
 __all__ = ["denoise"]
@@ -26,13 +27,8 @@ def _pyoidn() -> Any:
 
 
 def _image(value: Any, name: str, shape: Optional[tuple]) -> np.ndarray:
-    values = np.asarray(value)
-    # Numbers only, as lumiere.write_image takes them: None would become NaN, a complex value
-    # would lose its imaginary part, and a string of digits would be read as a number.
-    if values.dtype.kind not in "buif":
-        raise LumiereError(f"{name} must hold numbers, got an array of {values.dtype}")
-    with np.errstate(over="ignore"):
-        array = np.ascontiguousarray(values, dtype=np.float32)
+    # Numbers only, as lumiere.write_image takes them.
+    array = _float32_array(value, name)
     if array.ndim != 3 or array.shape[2] != 3 or min(array.shape[:2]) == 0:
         raise LumiereError(f"{name} must have shape (height, width, 3), got {array.shape}")
     if shape is not None and array.shape != shape:

@@ -67,6 +67,18 @@ def _float32(value: Any, what: str) -> float:
     return number
 
 
+def _float32_array(values: Any, what: str) -> np.ndarray:
+    """``values`` as a contiguous float32 array, if it holds numbers: an object array's None (or
+    a string of digits) would be converted silently, None to NaN, and a complex value would lose
+    its imaginary part. Values beyond float32 become infinities, as the CLI's would (numpy's
+    overflow warning would point at this line, not the caller's)."""
+    values = np.asarray(values)
+    if values.dtype.kind not in "buif":
+        raise LumiereError(f"{what} must hold numbers, got an array of {values.dtype}")
+    with np.errstate(over="ignore"):
+        return np.ascontiguousarray(values, dtype=np.float32)
+
+
 def _number(value: Any, what: str) -> float:
     """``value`` as a float, if it is a number (not a bool, not a string such as "45")."""
     if isinstance(value, (bool, np.bool_, str, bytes)):

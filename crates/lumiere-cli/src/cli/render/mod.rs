@@ -16,7 +16,9 @@ use glam::Vec3;
 use lumiere::Result;
 use lumiere::accel::BuildPreset;
 use lumiere::error::{Error, shown_name, shown_path};
-use lumiere::image_io::{ExrLayer, NOISY_LAYER, PngEncoding, PngStyle, Tonemap, write_exr_with_layers, write_image};
+use lumiere::image_io::{
+    ExrLayer, NOISY_LAYER, PngEncoding, PngStyle, RGB_CHANNELS, Tonemap, write_exr_with_layers, write_image,
+};
 use lumiere::render::aov::{Aov, render_aovs};
 use lumiere::render::film::Film;
 use lumiere::render::fingerprint::{Fingerprints, scene_fingerprint};
@@ -288,7 +290,7 @@ fn write_output(
         .collect();
     let exr = args.output.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
     if denoised.is_some() && exr {
-        layers.push(ExrLayer { name: NOISY_LAYER, channels: &["R", "G", "B"], pixels: &image.pixels });
+        layers.push(ExrLayer { name: NOISY_LAYER, channels: RGB_CHANNELS, pixels: &image.pixels });
     }
     if layers.is_empty() {
         return write_image(&args.output, image.width, image.height, pixels, png_style(args));
