@@ -12,11 +12,14 @@
 
 use lumiere::Error;
 use lumiere::integrators::Technique;
+use lumiere::materials::Material;
 use lumiere::render::checkpoint::Checkpoint;
 use lumiere::render::{RenderOptions, render};
+use lumiere::scene::Scene;
 use lumiere::scene::camera::{Camera, Orbiter};
 use lumiere::scene::load::obj::{ObjScene, parse_obj, parse_obj_with_chunk_size};
-use lumiere::scene::mesh::NO_INDEX;
+use lumiere::scene::load::ply::parse_ply;
+use lumiere::scene::mesh::{NO_INDEX, TriangleMesh};
 use lumiere::util::hash::StableHasher;
 use lumiere::world::World;
 use std::io;
@@ -24,6 +27,8 @@ use std::path::{Path, PathBuf};
 
 /// The name parse errors must carry in the OBJ targets.
 pub const OBJ_NAME: &str = "fuzz.obj";
+/// The name errors must carry in the PLY target.
+pub const PLY_NAME: &str = "fuzz.ply";
 /// The name parse errors must carry in the orbiter target.
 pub const ORBITER_NAME: &str = "fuzz_orbiter.txt";
 /// The name errors must carry in the checkpoint target.
@@ -33,8 +38,9 @@ pub const CHECKPOINT_NAME: &str = "fuzz.ckpt";
 pub type Target = fn(&[u8]) -> Result<(), String>;
 
 /// Every target, by the name of its `fuzz_targets/*.rs` file and `fuzz/corpus/` folder.
-pub const TARGETS: [(&str, Target); 7] = [
+pub const TARGETS: [(&str, Target); 8] = [
     ("obj", obj_target),
+    ("ply", ply_target),
     ("obj_chunks", obj_chunks_target),
     ("mtl", mtl_target),
     ("orbiter", orbiter_target),
@@ -118,6 +124,15 @@ pub fn orbiter_target(data: &[u8]) -> Result<(), String> {
     Ok(())
 }
 
+/// Target `ply`: `parse_ply` on a PLY file's bytes, ASCII or binary.
+pub fn ply_target(data: &[u8]) -> Result<(), String> {
+    let file = Path::new(PLY_NAME);
+    match parse_ply(data, file) {
+        Ok(scene) => check_ply_scene(&scene),
+        Err(error) => check_ply_error(&error, file, data),
+    }
+}
+
 /// Target `scene`, end to end: input as for `obj`; whatever parses must also become a scene, a
 /// BVH and an 8x6 image in every mode (1 sample) without panicking, with finite pixels.
 pub fn scene_target(data: &[u8]) -> Result<(), String> {
@@ -199,7 +214,28 @@ pub fn check_error(error: &Error, file: &Path, lines: usize) -> Result<(), Strin
 
 /// Everything `parse_obj` returned is consistent and finite.
 pub fn check_obj_scene(scene: &ObjScene) -> Result<(), String> {
-    let mesh = &scene.mesh;
+    check_mesh(&scene.mesh, &scene.materials, &scene.warnings)
+}
+
+/// Everything `parse_ply` returned is consistent and finite.
+pub fn check_ply_scene(scene: &Scene) -> Result<(), String> {
+    check_mesh(&scene.mesh, &scene.materials, &scene.warnings)
+}
+
+/// A PLY error is one line naming the file and where: a line of the header or of an ASCII body,
+/// or a byte of a binary body (`fuzz.ply: byte N: ...`, N within the input).
+pub fn check_ply_error(error: &Error, file: &Path, bytes: &[u8]) -> Result<(), String> {
+    let Error::Invalid(message) = error else { return check_error(error, file, line_count(bytes)) };
+    let place = message.strip_prefix(&format!("{}: byte ", file.display())).and_then(|rest| rest.split_once(": "));
+    match place.map(|(byte, _)| byte.parse::<usize>()) {
+        _ if message.contains('\n') => Err(format!("error message spans several lines: {message:?}")),
+        Some(Ok(byte)) if byte <= bytes.len() => Ok(()),
+        _ => Err(format!("expected file:line or file: byte N within the {} bytes, got: {message}", bytes.len())),
+    }
+}
+
+/// A mesh, its materials and warnings are consistent and finite.
+fn check_mesh(mesh: &TriangleMesh, materials: &[Material], warnings: &[String]) -> Result<(), String> {
     let triangles = mesh.indices.len();
     if let Some((i, p)) = mesh.positions.iter().enumerate().find(|(_, p)| !p.is_finite()) {
         return Err(format!("position {i} is not finite: {p}"));
@@ -218,8 +254,8 @@ pub fn check_obj_scene(scene: &ObjScene) -> Result<(), String> {
     if mesh.material_ids.len() != triangles {
         return Err(format!("{} material ids for {triangles} triangles", mesh.material_ids.len()));
     }
-    if let Some((t, &m)) = mesh.material_ids.iter().enumerate().find(|(_, m)| **m as usize >= scene.materials.len()) {
-        return Err(format!("triangle {t} has material {m} of {}", scene.materials.len()));
+    if let Some((t, &m)) = mesh.material_ids.iter().enumerate().find(|(_, m)| **m as usize >= materials.len()) {
+        return Err(format!("triangle {t} has material {m} of {}", materials.len()));
     }
     let attributes = [
         ("normal", &mesh.normal_indices, mesh.normals.len()),
@@ -235,14 +271,14 @@ pub fn check_obj_scene(scene: &ObjScene) -> Result<(), String> {
             }
         }
     }
-    for material in &scene.materials {
+    for material in materials {
         let numbers = [material.kd, material.ks, material.ke];
         let scalars = [material.ns, material.ni, material.dissolve];
         if !numbers.iter().all(|v| v.is_finite()) || !scalars.iter().all(|v| v.is_finite()) {
             return Err(format!("material {:?} has a non-finite value: {material:?}", material.name));
         }
     }
-    if let Some(warning) = scene.warnings.iter().find(|w| w.contains('\n')) {
+    if let Some(warning) = warnings.iter().find(|w| w.contains('\n')) {
         return Err(format!("warning spans several lines: {warning:?}"));
     }
     Ok(())

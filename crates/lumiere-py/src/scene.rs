@@ -71,7 +71,8 @@ impl PyScene {
 
 #[pymethods]
 impl PyScene {
-    /// Loads an OBJ (or .obj.gz) file with its MTL, or the built-in scene when `path` is None.
+    /// Loads an OBJ file with its MTL or a PLY file (either also gzipped), or the built-in scene
+    /// when `path` is None.
     /// Ctrl-C returns at once, as during the build (the load ends in the background, unused).
     #[staticmethod]
     #[pyo3(signature = (path, emission))]

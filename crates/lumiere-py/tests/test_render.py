@@ -123,6 +123,30 @@ def test_scene_from_arrays_and_info():
         lumiere.Scene.from_arrays(np.zeros((4, 2)), [[0, 1, 2]])
 
 
+def test_a_binary_ply_file_renders_as_the_same_arrays(tmp_path):
+    # A binary PLY as numpy writes one, with normals: the same render as the arrays it holds, and
+    # its one material is the one emission names.
+    vertices = np.array([[-1, 0, -1], [1, 0, -1], [0, 0, 1], [-1, 2, -1], [1, 2, -1], [0, 2, 1]], dtype="<f4")
+    triangles = np.array([[0, 2, 1], [3, 4, 5]], dtype="<i4")
+    faces = np.zeros(2, dtype=[("n", "u1"), ("corners", "<i4", 3)])
+    faces["n"], faces["corners"] = 3, triangles
+    header = ("ply\nformat binary_little_endian 1.0\nelement vertex 6\nproperty float x\nproperty float y\n"
+              "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n")
+    ply = tmp_path / "two.ply"
+    ply.write_bytes(header.encode() + vertices.tobytes() + faces.tobytes())
+    scene = lumiere.load(ply, emission={"default": (1, 1, 1)})
+    assert scene.warnings == [] and scene.info()["triangles"] == 2
+    twin = lumiere.Scene.from_arrays(vertices, triangles, materials=[{"name": "default", "ke": (1, 1, 1)}])
+    camera = lumiere.Camera.look_at((0, 1, 4), (0, 1, 0), size=(16, 12))
+    image = lumiere.render(scene, camera, spp=2)
+    assert image.max() > 0
+    assert np.array_equal(bits(image), bits(lumiere.render(twin, camera, spp=2)))
+    assert np.array_equal(bits(image), bits(lumiere.render(pickle.loads(pickle.dumps(scene)), camera, spp=2)))
+    ply.write_bytes(header.encode() + vertices.tobytes() + faces.tobytes()[:-3])
+    with pytest.raises(lumiere.LumiereError, match=r"two\.ply: byte \d+: face 1: the file ends"):
+        lumiere.load(ply)
+
+
 def grey_png(path, values):
     """A one-row 8-bit grey PNG of `values`, written without an imaging library."""
     import struct

@@ -103,7 +103,8 @@ pub struct BenchBvhArgs {
 
 #[derive(Args, Debug)]
 pub struct InfoArgs {
-    /// Wavefront OBJ file (.obj or .obj.gz) with its MTL files; the built-in scene when omitted.
+    /// Scene file: Wavefront OBJ (.obj or .obj.gz) with its MTL files, or PLY (.ply or .ply.gz);
+    /// the built-in scene when omitted.
     pub scene: Option<PathBuf>,
 }
 
@@ -150,7 +151,8 @@ pub enum LightSamplingArg {
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// Wavefront OBJ file (.obj or .obj.gz); the built-in gKit Cornell box when omitted.
+    /// Scene file: Wavefront OBJ (.obj or .obj.gz) with its MTL files, or PLY (.ply or .ply.gz);
+    /// the built-in gKit Cornell box when omitted.
     pub scene: Option<PathBuf>,
 
     /// What to compute per pixel: path tracing, or one of the lab's steps.

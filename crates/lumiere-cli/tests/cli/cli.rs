@@ -274,6 +274,41 @@ fn assert_refused(dir: &TempDir, args: &[&str], expected: &str) {
     assert!(!out.exists(), "{args:?} left an output file");
 }
 
+/// A PLY file renders as the OBJ file of the same faces does, byte for byte: the same triangles
+/// in the same order, and the same grey default material.
+#[test]
+fn a_ply_scene_renders_as_its_obj_twin() {
+    let dir = TempDir::new("ply-twin");
+    let corners = [[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [1.5, 1.0, 0.0], [-1.0, 1.0, 0.5], [0.0, 0.0, 1.0]];
+    let faces: [&[usize]; 2] = [&[0, 1, 2, 3], &[0, 1, 4]];
+    let mut obj = String::new();
+    let mut ply = format!(
+        "ply\nformat ascii 1.0\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\n\
+         element face {}\nproperty list uchar int vertex_indices\nend_header\n",
+        corners.len(),
+        faces.len()
+    );
+    for [x, y, z] in corners {
+        obj += &format!("v {x} {y} {z}\n");
+        ply += &format!("{x} {y} {z}\n");
+    }
+    for face in faces {
+        obj += &format!("f{}\n", face.iter().map(|i| format!(" {}", i + 1)).collect::<String>());
+        ply += &format!("{}{}\n", face.len(), face.iter().map(|i| format!(" {i}")).collect::<String>());
+    }
+    let mut images = Vec::new();
+    for (name, text) in [("twin.obj", obj), ("twin.ply", ply)] {
+        let scene = dir.write(name, text);
+        let out = dir.arg(&format!("{name}.pfm"));
+        let args = ["render", scene.to_str().unwrap(), "--mode", "ao", "--samples", "4", "--size", "32x24", "-o", &out];
+        let run = lumiere(&args);
+        assert!(run.status.success(), "{name}: {}", stderr(&run));
+        assert_eq!(stderr(&run).matches("warning").count(), 0, "{name}: {}", stderr(&run));
+        images.push(fs::read(&out).unwrap());
+    }
+    assert!(images[0] == images[1], "the PLY's image differs from the OBJ's");
+}
+
 #[test]
 fn bad_inputs_give_a_clear_error_and_no_file() {
     let dir = TempDir::new("bad");
@@ -290,6 +325,12 @@ fn bad_inputs_give_a_clear_error_and_no_file() {
     assert_refused(&dir, &["render", nan.to_str().unwrap()], "nan.obj:2");
     let inf = dir.write("inf.obj", "v 0 0 0\nv 1 0 0\nv 0 inf 0\nf 1 2 3\n");
     assert_refused(&dir, &["render", inf.to_str().unwrap()], "inf.obj:3");
+    // A binary PLY cut short inside its second vertex: refused from its header's count.
+    let header = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+    let short = dir.write("short.ply", [header.as_bytes(), &[0; 16]].concat());
+    let expected =
+        "short.ply:3: element \"vertex\" declares 3 of them, more than the 16 bytes after the header can hold";
+    assert_refused(&dir, &["render", short.to_str().unwrap()], expected);
 
     assert_refused(&dir, &["render", "--size", "0x768"], "no pixels");
     assert_refused(&dir, &["render", "--size", "banana"], "WIDTHxHEIGHT");
@@ -334,7 +375,7 @@ fn bad_inputs_give_a_clear_error_and_no_file() {
         assert!(stderr(&run).contains(expected), "{}", stderr(&run));
         assert!(path == folder || !Path::new(path).exists());
     }
-    assert_eq!(dir.entries(), ["bad_number.obj", "inf.obj", "nan.obj", "range.obj"]);
+    assert_eq!(dir.entries(), ["bad_number.obj", "inf.obj", "nan.obj", "range.obj", "short.ply"]);
 }
 
 /// `$LUMIERE_ISA` forces the ISA when `--isa` is absent, and is checked like the flag.

@@ -1,6 +1,7 @@
 //! Property-based fuzzing of every parser, on stable Rust and fast enough for CI: random bytes,
 //! random token soup, and random mutations (bit flips, truncations, deletions, line duplication
-//! and swaps, splices, hostile tokens) of the shipped scenes and orbiter files. Each input goes
+//! and swaps, splices, hostile tokens) of the shipped scenes, orbiter files and PLY seeds, and
+//! random PLY bodies under the seeds' headers. Each input goes
 //! through the same checks as the libFuzzer targets in `fuzz/` (`fuzz/src/harness.rs`): no panic,
 //! no hang (each input has a deadline), and an Ok result must be consistent (indices and material
 //! ids in range, finite numbers) while an error must be one line naming the file and a real line.
@@ -13,7 +14,7 @@
 //! docs/FUZZING.md.
 
 use crate::harness::{
-    checkpoint_target, guarded, mtl_target, obj_chunks_target, obj_target, orbiter_target, raw_checkpoint,
+    checkpoint_target, guarded, mtl_target, obj_chunks_target, obj_target, orbiter_target, ply_target, raw_checkpoint,
     scene_target, with_checksum,
 };
 use crate::process::{Limits, TempDir, check_exit, run};
@@ -31,7 +32,14 @@ const MCGUIRE_MTL: &[u8] = include_bytes!("../corpus/seeds/CornellBox-Original.m
 const ORBITER_2022: &[u8] = include_bytes!("../../../lumiere/assets/cornell/cornell_orbiter.txt");
 const ORBITER_2020: &[u8] = include_bytes!("../../../lumiere/assets/cornell/cornell_orbiter_2020.txt");
 
+// PLY seeds: ASCII quads with normals and colours; binary doubles, lists of each byte order, an
+// element skipped between vertices and faces, a concave face.
+const CUBE_PLY: &[u8] = include_bytes!("../corpus/seeds/cube-ascii.ply");
+const HEXAGON_LE_PLY: &[u8] = include_bytes!("../corpus/seeds/hexagon-le.ply");
+const HEXAGON_BE_PLY: &[u8] = include_bytes!("../corpus/seeds/hexagon-be.ply");
+
 const OBJS: [&[u8]; 2] = [CORNELL_OBJ, MCGUIRE_OBJ];
+const PLYS: [&[u8]; 3] = [CUBE_PLY, HEXAGON_LE_PLY, HEXAGON_BE_PLY];
 const MTLS: [&[u8]; 2] = [CORNELL_MTL, MCGUIRE_MTL];
 const ORBITERS: [&[u8]; 2] = [ORBITER_2022, ORBITER_2020];
 
@@ -325,6 +333,19 @@ proptest! {
         // Through the scene's own OBJ (its material names) and through the synthetic one.
         check!(obj_target, with_mtl(OBJS[scene], &mtl));
         check!(mtl_target, mtl);
+    }
+
+    #[test]
+    fn ply_mutated_seeds(file in 0..PLYS.len(), mutations in prop::collection::vec(mutation(), 1..10)) {
+        let ply = mutate(PLYS[file], &mutations, &PLYS);
+        check!(ply_target, ply);
+    }
+
+    /// A seed's header over random bytes: every value of a binary body read from noise.
+    #[test]
+    fn ply_random_bodies(file in 0..PLYS.len(), body in prop::collection::vec(any::<u8>(), 0..600)) {
+        let header = PLYS[file].windows(11).position(|w| w == b"end_header\n").map_or(0, |at| at + 11);
+        check!(ply_target, [&PLYS[file][..header], &body].concat());
     }
 
     #[test]

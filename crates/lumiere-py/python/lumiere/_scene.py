@@ -166,7 +166,7 @@ def _size(size: Any) -> Tuple[int, int]:
 class Scene:
     """A scene ready to render: triangles, materials, and the BVH and lights built from them.
 
-    Make one with :func:`lumiere.load` (an OBJ file), :func:`lumiere.builtin` (gKit's Cornell box)
+    Make one with :func:`lumiere.load` (an OBJ or PLY file), :func:`lumiere.builtin` (gKit's Cornell box)
     or :meth:`Scene.from_arrays` (numpy arrays). Scenes pickle by recipe: the unpickling process
     loads the file again (it must see the same file) or rebuilds the arrays.
     """
@@ -354,7 +354,9 @@ def _rebuild_scene(recipe: tuple) -> Scene:
 
 
 def load(path: PathLike, emission: Optional[Mapping[str, Vector]] = None) -> Scene:
-    """Loads a Wavefront OBJ scene (``.obj`` or ``.obj.gz``, with its MTL files and textures).
+    """Loads a scene file: Wavefront OBJ (``.obj`` or ``.obj.gz``, with its MTL files and
+    textures) or PLY (``.ply`` or ``.ply.gz``: its vertices, normals and faces, with one grey
+    material named ``default``).
 
     :param emission: sets the emitted radiance of materials by name, as ``--emission`` does:
         ``{"Light": (17, 12, 4)}``; a name the scene lacks is an error.

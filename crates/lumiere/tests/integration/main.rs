@@ -18,6 +18,7 @@ mod obj_loading;
 mod outputs;
 mod packets;
 mod path;
+mod ply_loading;
 mod quad_lights;
 mod range;
 mod sampling;

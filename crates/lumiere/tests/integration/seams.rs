@@ -531,7 +531,7 @@ fn scene_files_are_loaded_by_extension_or_refused_naming_it() {
     let obj = dir.write("UPPER.OBJ", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
     assert_eq!(Scene::load(&obj).unwrap().mesh.triangle_count(), 1);
     for (name, expected) in [
-        ("model.ply", ".ply scenes are not supported"),
+        ("model.stl", ".stl scenes are not supported"),
         ("model.gltf", ".gltf scenes are not supported"),
         ("noextension", "no extension"),
         // Not "no extension": the name has one, and what it lacks is the one inside.
@@ -540,8 +540,12 @@ fn scene_files_are_loaded_by_extension_or_refused_naming_it() {
         let path = dir.write(name, "v 0 0 0\n");
         let message = Scene::load(&path).unwrap_err().to_string();
         assert!(message.contains(expected) && message.contains(name), "{name}: {message}");
-        assert!(message.contains(".obj"), "the message names what is supported: {message}");
+        assert!(message.contains(".obj") && message.contains(".ply"), "the message names what is supported: {message}");
     }
+    // The extension chooses the loader, and the loader checks what the file holds.
+    let obj_text = dir.write("model.ply", "v 0 0 0\n");
+    let message = Scene::load(&obj_text).unwrap_err().to_string();
+    assert!(message.ends_with("model.ply:1: not a PLY file: its first line is not \"ply\""), "{message}");
 }
 
 #[test]

@@ -3,6 +3,8 @@
 
 pub mod memory;
 pub mod obj;
+pub mod ply;
+mod polygon;
 pub mod warnings;
 
 use std::path::Path;
@@ -12,7 +14,7 @@ use crate::scene::Scene;
 use crate::util::read::refuse_special;
 
 /// The scene formats lumiere reads, named as in messages.
-const SUPPORTED: &str = ".obj or .obj.gz (with their .mtl files)";
+const SUPPORTED: &str = ".obj (with its .mtl files) or .ply, either also gzipped (.obj.gz, .ply.gz)";
 
 /// Loads the scene file at `path`, choosing the loader by its extension (case-insensitive).
 pub fn load(path: &Path) -> Result<Scene> {
@@ -26,12 +28,13 @@ pub fn load(path: &Path) -> Result<Scene> {
     let extension = Path::new(stem).extension().map(|e| e.to_string_lossy().into_owned()).unwrap_or_default();
     match extension.as_str() {
         "obj" => obj::load_obj(path)?.into_scene(shown_path(path)),
+        "ply" => ply::load_ply(path),
         "mtl" => Err(Error::invalid(format!(
             "{}: is a material library (.mtl), not a scene; give the .obj file that names it with mtllib",
             shown_path(path)
         ))),
         "" if stem.len() < name.len() => Err(Error::invalid(format!(
-            "{}: a gzip file whose name does not say what it holds; name a compressed OBJ scene .obj.gz",
+            "{}: a gzip file whose name does not say what it holds; name a compressed scene .obj.gz or .ply.gz",
             shown_path(path)
         ))),
         "" => Err(Error::invalid(format!(

@@ -16,7 +16,6 @@ mod chunk;
 mod continued;
 mod materials;
 mod mtl;
-mod polygon;
 mod skipped;
 mod text;
 
@@ -24,6 +23,7 @@ use crate::error::{Error, Result, shown_bytes, shown_path};
 use crate::materials::Material;
 use crate::scene::Scene;
 use crate::scene::load::memory::{Memory, MeshSize, check_mesh_memory};
+use crate::scene::load::polygon;
 use crate::scene::mesh::{NO_INDEX, TriangleMesh};
 use crate::util::read;
 use chunk::{ChunkCounts, ChunkMesh, ChunkStart, Dropped, VertexCounts, parse_chunk};
@@ -172,25 +172,7 @@ fn parse_obj_within(
     warn_dropped(&mut table, name, normals, "normal", "normals", "normal indices out of range");
     skipped.warn(&mut table.warnings, name);
     let mut mesh = merge(&parsed, material_ids);
-    let unclipped = polygon::clip_concave_faces(&mut mesh, &polygons_in_file(&parsed));
-    let (too_large, out_of_budget) = (unclipped.too_large, unclipped.out_of_budget);
-    if too_large > 0 {
-        table.warnings.push(name, "concave faces too large to split", || {
-            format!(
-                "{}: {too_large} concave face(s) of more than {} corners keep their fan of triangles, which covers them wrongly",
-                shown_path(name),
-                polygon::MAX_CLIPPED_CORNERS
-            )
-        });
-    }
-    if out_of_budget > 0 {
-        table.warnings.push(name, "concave faces past the splitting budget", || {
-            format!(
-                "{}: {out_of_budget} concave face(s) keep their fan of triangles, which covers them wrongly: splitting the file's concave faces took too long",
-                shown_path(name)
-            )
-        });
-    }
+    polygon::clip_concave_faces(&mut mesh, &polygons_in_file(&parsed)).warn(&mut table.warnings, name);
     let warnings = std::mem::take(&mut table.warnings).finish();
     Ok(ObjScene { mesh, materials: table.materials, warnings, material_files: table.files })
 }

@@ -5,10 +5,10 @@
 //! whole file has. [`parse_chunk`] then turns relative (negative) indices into absolute ones at
 //! once and reports errors with their line number in the file, with no fix-up pass afterwards.
 
-use super::polygon::Polygon;
 use super::skipped::{SkippedKeywords, is_silent};
 use super::text::{Tokens, finite_f32, lines, saturating_i64};
 use crate::error::{Error, Result, quote};
+use crate::scene::load::polygon::Polygon;
 use crate::scene::mesh::NO_INDEX;
 use glam::{Vec2, Vec3};
 use std::borrow::Cow;

@@ -11,19 +11,22 @@
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
+use crate::error::shown_path;
+use crate::scene::load::warnings::Warnings;
 use crate::scene::mesh::TriangleMesh;
+use std::path::Path;
 
 /// A face of more than three corners: its fan's first triangle and its corner count.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Polygon {
-    pub(super) first_triangle: usize,
-    pub(super) corners: usize,
+pub(in crate::scene::load) struct Polygon {
+    pub(in crate::scene::load) first_triangle: usize,
+    pub(in crate::scene::load) corners: usize,
 }
 
 /// The most corners a concave face may have to be ear-clipped; larger ones keep their fan (and a
 /// warning says how many). Ear clipping tests every corner against every candidate ear, so its
 /// work grows as the cube of the corners.
-pub(super) const MAX_CLIPPED_CORNERS: usize = 64;
+const MAX_CLIPPED_CORNERS: usize = 64;
 
 /// Corner-against-ear tests a whole file may ask for (a few tenths of a second): past them, the
 /// concave faces left keep their fans. Real faces find an ear within a few tries, a few thousand
@@ -33,16 +36,39 @@ const WORK_BUDGET: u64 = 50_000_000;
 
 /// The concave faces that keep their fan, by reason.
 #[derive(Clone, Copy, Debug, Default)]
-pub(super) struct Unclipped {
+pub(in crate::scene::load) struct Unclipped {
     /// More than [`MAX_CLIPPED_CORNERS`] corners.
-    pub(super) too_large: usize,
+    too_large: usize,
     /// Met after the file's [`WORK_BUDGET`] was spent.
-    pub(super) out_of_budget: usize,
+    out_of_budget: usize,
+}
+
+impl Unclipped {
+    /// One warning per reason that left faces of `file` unclipped.
+    pub(in crate::scene::load) fn warn(self, warnings: &mut Warnings, file: &Path) {
+        let Unclipped { too_large, out_of_budget } = self;
+        if too_large > 0 {
+            warnings.push(file, "concave faces too large to split", || {
+                format!(
+                    "{}: {too_large} concave face(s) of more than {MAX_CLIPPED_CORNERS} corners keep their fan of triangles, which covers them wrongly",
+                    shown_path(file)
+                )
+            });
+        }
+        if out_of_budget > 0 {
+            warnings.push(file, "concave faces past the splitting budget", || {
+                format!(
+                    "{}: {out_of_budget} concave face(s) keep their fan of triangles, which covers them wrongly: splitting the file's concave faces took too long",
+                    shown_path(file)
+                )
+            });
+        }
+    }
 }
 
 /// Replaces the fan of every concave face of `polygons` (whose triangles `mesh` holds as the parser
 /// made them) by an ear clipping of it, in file order; returns what was left unclipped.
-pub(super) fn clip_concave_faces(mesh: &mut TriangleMesh, polygons: &[Polygon]) -> Unclipped {
+pub(in crate::scene::load) fn clip_concave_faces(mesh: &mut TriangleMesh, polygons: &[Polygon]) -> Unclipped {
     // Told apart in parallel (a mesh of quads has millions of faces), as one flag per face: an
     // indexed collection into one buffer, where collecting the concave faces themselves went
     // through a list of buffers per task (a third of the pass on a mesh of warped quads). Each
