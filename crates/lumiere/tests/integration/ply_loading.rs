@@ -376,3 +376,31 @@ fn a_mesh_too_big_for_the_memory_left_is_refused() {
     let scene = parse_ply_with_memory(&bytes, Path::new("big.ply"), 1 << 30).unwrap();
     assert_eq!(scene.mesh.triangle_count(), faces);
 }
+
+#[test]
+fn headers_of_many_names_load_quickly_and_are_warned_about_in_a_line() {
+    // Each name is checked against those before it through a set: compared one by one, these
+    // 200,000 properties and elements took minutes. Warnings list eight names and count the rest.
+    const N: usize = 200_000;
+    let mut header = String::from("element vertex 1\n");
+    header += &(0..N).map(|i| format!("property uchar p{i}\n")).collect::<String>();
+    header += XYZ;
+    header += &(0..N).map(|i| format!("element e{i} 1\n")).collect::<String>();
+    let mut row = vec![Value::U8(0); N];
+    row.extend(xyz([0.0, 0.0, 0.0]));
+    let start = std::time::Instant::now();
+    let scene = parse(&ply(Format::Ascii, &header, &[row]));
+    assert!(start.elapsed() < std::time::Duration::from_secs(10), "took {:?}", start.elapsed());
+    assert_eq!(scene.mesh.positions.len(), 1);
+    let expected = [
+        format!(
+            "test.ply:3: vertex properties not read: \"p0\", \"p1\", \"p2\", \"p3\", \"p4\", \"p5\", \"p6\", \"p7\" and {} more",
+            N - 8
+        ),
+        format!(
+            "test.ply: elements not read (lumiere reads vertex and face): \"e0\" (1), \"e1\" (1), \"e2\" (1), \"e3\" (1), \"e4\" (1), \"e5\" (1), \"e6\" (1), \"e7\" (1) and {} more",
+            N - 8
+        ),
+    ];
+    assert_eq!(scene.warnings, expected);
+}

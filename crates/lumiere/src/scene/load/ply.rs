@@ -146,7 +146,7 @@ impl Layout {
                 }
             };
             if !ignored.is_empty() && element.count > 0 {
-                let names = ignored.iter().map(quote).collect::<Vec<_>>().join(", ");
+                let names = listed(ignored.iter().map(quote).collect());
                 warnings.push(file, "properties not read", || {
                     format!("{}:{}: {} properties not read: {names}", shown_path(file), element.line, element.name)
                 });
@@ -154,13 +154,23 @@ impl Layout {
         }
         if !ignored_elements.is_empty() {
             warnings.push(file, "elements not read", || {
-                let elements = ignored_elements.join(", ");
+                let elements = listed(std::mem::take(&mut ignored_elements));
                 format!("{}: elements not read (lumiere reads vertex and face): {elements}", shown_path(file))
             });
         }
         Ok(Layout { vertices, faces })
     }
 }
+
+/// Names as a warning lists them: the first [`LISTED`], then how many more, so that a header of a
+/// hundred thousand properties gives a line, not megabytes.
+fn listed(names: Vec<String>) -> String {
+    let more = names.len().saturating_sub(LISTED);
+    let shown = names.into_iter().take(LISTED).collect::<Vec<_>>().join(", ");
+    if more > 0 { format!("{shown} and {more} more") } else { shown }
+}
+
+const LISTED: usize = 8;
 
 const COORDINATES: [&str; 6] = ["x", "y", "z", "nx", "ny", "nz"];
 

@@ -3,6 +3,7 @@
 //! says.
 
 use crate::error::{Error, Result, quote};
+use std::collections::HashSet;
 use std::path::Path;
 
 /// How the body stores its values.
@@ -136,6 +137,9 @@ pub(super) struct Header {
 pub(super) fn parse_header(bytes: &[u8], file: &Path) -> Result<Header> {
     let mut format = None;
     let mut elements: Vec<Element> = Vec::new();
+    // Names seen, to refuse repeats without comparing each new one with all before it (a header of
+    // a hundred thousand properties is a few megabytes).
+    let mut names: HashSet<(usize, String)> = HashSet::new();
     let mut start = 0;
     let mut number = 0;
     loop {
@@ -154,9 +158,6 @@ pub(super) fn parse_header(bytes: &[u8], file: &Path) -> Result<Header> {
             continue;
         }
         let error = |message: String| Error::parse(file, number, message);
-        if !line.is_ascii() || line.contains(&0) {
-            return Err(error("the header holds a byte that is not ASCII text".to_string()));
-        }
         let mut words = line.split(u8::is_ascii_whitespace).filter(|word| !word.is_empty());
         match words.next() {
             Some(b"end_header") => break,
@@ -165,17 +166,18 @@ pub(super) fn parse_header(bytes: &[u8], file: &Path) -> Result<Header> {
             Some(b"format") => format = Some(parse_format(words.collect()).map_err(error)?),
             Some(b"element") => {
                 let element = parse_element(words.collect(), number).map_err(error)?;
-                if elements.iter().any(|e| e.name == element.name) {
+                if !names.insert((usize::MAX, element.name.clone())) {
                     return Err(error(format!("a second element {}", quote(&element.name))));
                 }
                 elements.push(element);
             }
             Some(b"property") => {
+                let owner = elements.len();
                 let Some(element) = elements.last_mut() else {
                     return Err(error("a property before any element".to_string()));
                 };
                 let property = parse_property(words.collect()).map_err(error)?;
-                if element.property(&property.name).is_some() {
+                if !names.insert((owner, property.name.clone())) {
                     let (property, element) = (quote(&property.name), quote(&element.name));
                     return Err(error(format!("a second property {property} in element {element}")));
                 }
