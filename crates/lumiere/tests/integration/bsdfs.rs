@@ -479,6 +479,52 @@ fn plastic_picks_its_lobes_in_proportion_to_their_albedo_estimates() {
     assert_passes("plastic lobe choice", lumiere::sampling::chi2::chi2_discrete(&expected, &counts));
 }
 
+/// A plastic samples wherever it reflects light, and only there: a black one (no base, no coat)
+/// gives no sample at all (a sample of weight 0 would only cost the integrator a ray), a plastic
+/// that is all base gives a diffuse sample for every `u`, and one that is all coat only glossy
+/// samples, with positive pdfs. The other plastics under test have both lobes, where a wrong
+/// test of the lobe probability or of the base colour goes unseen.
+#[test]
+fn plastic_samples_where_it_reflects_and_only_there() {
+    let wo = viewing_directions()[1].1;
+    let black = Plastic::new(Vec3::ZERO, Vec3::ZERO, 0.3);
+    let base_only = Plastic::new(Vec3::new(0.7, 0.5, 0.3), Vec3::ZERO, 0.3);
+    let coat_only = Plastic::new(Vec3::ZERO, Vec3::splat(0.5), 0.3);
+    let mut glossy = 0;
+    for i in 0..16 {
+        for j in 0..16 {
+            let u = Vec2::new((i as f32 + 0.5) / 16.0, (j as f32 + 0.5) / 16.0);
+            assert_eq!(black.sample(wo, u), None, "black plastic, u {u}");
+            let s = base_only.sample(wo, u).unwrap_or_else(|| panic!("base only, u {u}: no sample"));
+            assert!(s.flags.contains(BsdfFlags::DIFFUSE) && s.pdf > 0.0, "base only, u {u}: {s:?}");
+            if let Some(s) = coat_only.sample(wo, u) {
+                assert!(s.flags.contains(BsdfFlags::GLOSSY) && s.pdf > 0.0, "coat only, u {u}: {s:?}");
+                glossy += 1;
+            }
+        }
+    }
+    // At 60° with α 0.3, few reflected microfacet normals fall below the horizon.
+    assert!(glossy > 200, "coat only: {glossy} samples of 256");
+}
+
+/// `1 − 2⁻²⁴`, the largest `f32` below 1 (a uniform a sampler may deliver), still gives a diffuse
+/// direction. Remapped onto the diffuse lobe's share, `(u − p) / (1 − p)` rounds up to exactly 1
+/// for many specular probabilities `p` (0.0325, 0.044, …), and a cosine-weighted direction drawn at
+/// 1 lies in the horizon, where the pdf is 0: the remapped value must stay below 1.
+#[test]
+fn plastic_keeps_the_largest_uniform_below_one_in_its_diffuse_lobe() {
+    let u = Vec2::new(1.0f32.next_down(), 0.5);
+    for k in 1..=200 {
+        let plastic = Plastic::new(Vec3::ONE, Vec3::splat(k as f32 / 400.0), 0.3);
+        let s = plastic.sample(Vec3::Z, u).unwrap_or_else(|| panic!("p {}: no sample", plastic.specular_probability()));
+        assert!(
+            s.flags.contains(BsdfFlags::DIFFUSE) && s.wi.z > 0.0 && s.pdf > 0.0,
+            "p {}: {s:?}",
+            plastic.specular_probability()
+        );
+    }
+}
+
 /// Every sample carries exactly `eval` and `pdf` of its direction, with flags that say what it is;
 /// opaque lobes give nothing for `wo` below the surface, and nothing there evaluates.
 #[test]
