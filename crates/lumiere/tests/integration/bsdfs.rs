@@ -554,6 +554,42 @@ fn samples_carry_eval_and_pdf_of_their_direction() {
     }
 }
 
+/// A direction in the surface's plane (`z = ±0`) is not above it, and every opaque lobe gives it
+/// nothing: as `wo`, where `sample` has no direction for it, and as `wi`, where
+/// `Bsdf::lambertian_eval` promises `eval` is 0 (light sampling evaluates a diffuse surface's light
+/// points without calling `eval`). Random directions never lie exactly in the plane, so the other
+/// tests cannot see a lobe that counts `z = 0` as above.
+#[test]
+fn directions_in_the_surface_plane_get_nothing() {
+    let mut rng = TestRng(141);
+    for (name, bsdf) in glossy_lobes() {
+        for _ in 0..100 {
+            let (a, b) = (rng.direction(), rng.direction());
+            let above = Vec3::new(a.x, a.y, a.z.abs().max(0.1)).normalize();
+            let flat = Vec3::new(b.x, b.y, 0.0).normalize();
+            for flat in [flat, Vec3::new(flat.x, flat.y, -0.0)] {
+                assert_eq!((bsdf.eval(flat, above), bsdf.pdf(flat, above)), (Vec3::ZERO, 0.0), "{name}: wo {flat}");
+                assert_eq!((bsdf.eval(above, flat), bsdf.pdf(above, flat)), (Vec3::ZERO, 0.0), "{name}: wi {flat}");
+                assert_eq!(bsdf.sample(flat, Vec2::new(rng.f32(), rng.f32())), None, "{name}: wo {flat}");
+            }
+        }
+    }
+}
+
+/// `lambertian_eval(wo)` is the value `eval(wo, wi)` has for every `wi` above the surface: the
+/// `shadows` and `direct` integrators light a diffuse surface's light points with it and never
+/// call `eval`, so a wrong or missing value there goes unseen by every test of `eval`.
+#[test]
+fn lambertian_eval_is_the_value_of_every_direction_above() {
+    let mut rng = TestRng(151);
+    let lambert = Lambert { reflectance: Vec3::new(0.7, 0.5, 0.3) };
+    for _ in 0..1000 {
+        let (a, b) = (rng.direction(), rng.direction());
+        let (wo, wi) = (Vec3::new(a.x, a.y, a.z.abs()), Vec3::new(b.x, b.y, b.z.abs()));
+        assert_eq!(lambert.lambertian_eval(wo), Some(lambert.eval(wo, wi)), "wo {wo}, wi {wi}");
+    }
+}
+
 /// `pdf` integrates to at most 1 over the sphere: less where reflected directions fall below the
 /// horizon, which `sample` then rejects. In closed form at normal incidence: visible normals are
 /// then GGX's normals weighted by `cos θm`, of which the fraction with `tan θm ≤ 1` (reflections
