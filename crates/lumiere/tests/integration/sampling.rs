@@ -372,6 +372,17 @@ fn alias_table_edge_u_never_yields_zero_weights() {
     }
 }
 
+/// A table counts every item, zero-weight ones included, and is never empty: `new` refuses the
+/// weights of an empty one, so a caller that checks `is_empty` before sampling always samples.
+#[test]
+fn alias_table_counts_every_item_and_is_never_empty() {
+    for weights in [vec![2.5f32], vec![0.0, 1.0], weights_with_zeros(37)] {
+        let table = AliasTable::new(&weights).unwrap();
+        assert_eq!(table.len(), weights.len(), "{weights:?}");
+        assert!(!table.is_empty(), "{weights:?}: a built table reads as empty");
+    }
+}
+
 #[test]
 fn alias_table_rejects_nothing_to_sample() {
     assert!(AliasTable::new::<f32>(&[]).is_none());
