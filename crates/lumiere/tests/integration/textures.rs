@@ -287,6 +287,26 @@ fn alpha_is_kept_linear_and_sixteen_bit_pngs_decode_exactly() {
     assert!(close(texture.texel(1, 0), Vec3::new(expected(40_000), expected(1000), 1.0), 1e-7));
 }
 
+/// A 16-bit file's alpha is linear coverage too, read to its full depth: a cutout (`map_d`) drawn
+/// at 16 bits cuts where its alpha says, with levels that 8 bits cannot hold.
+#[test]
+fn sixteen_bit_alpha_is_kept_linear_to_its_full_depth() {
+    let dir = TempDir::new("textures-alpha16");
+    let levels = [0u16, 1000, 32_768, 40_000, 65_535];
+    let image = image::ImageBuffer::from_fn(5, 1, |x, _| Rgba([65_535u16, 0, 0, levels[x as usize]]));
+    let path = dir.path("alpha16.png");
+    image.save_with_format(&path, ImageFormat::Png).unwrap();
+    let texture = load_one(&path);
+    assert!(texture.has_alpha());
+    for (x, &level) in levels.iter().enumerate() {
+        let uv = centre(x as u32, 0, 5, 1);
+        let expected = f32::from(level) / 65_535.0;
+        let (alpha, coverage) = (texture.sample_alpha(uv), texture.sample_coverage(uv));
+        assert!((alpha - expected).abs() < 1e-6, "texel {x}: alpha {alpha} vs {expected}");
+        assert_eq!(coverage, alpha, "texel {x}: coverage is the alpha");
+    }
+}
+
 #[test]
 fn unusable_files_cost_one_warning_each_and_no_texture() {
     let dir = TempDir::new("textures-bad");
