@@ -262,14 +262,16 @@ fn what_the_body_holds_past_its_elements_is_named() {
 /// Refusals of the header, each with its line.
 #[test]
 fn malformed_headers_are_refused_with_their_line() {
-    let cases: [(&[u8], &str); 14] = [
+    let cases: [(&[u8], &str); 16] = [
         (b"", "test.ply:1: not a PLY file"),
         (b"solid cube\nfacet normal 0 0 1\n", "test.ply:1: not a PLY file"),
         (b"ply\nformat ascii 1.0\nelement vertex 0\n", "test.ply:4: the header has no end_header line"),
         (b"ply\nelement vertex 0\nend_header\n", "test.ply:3: the header ends without a format line"),
         (b"ply\nformat binary 1.0\nend_header\n", "test.ply:2: unknown format \"binary\""),
         (b"ply\nformat ascii 2.0\nend_header\n", "test.ply:2: PLY version \"2.0\" is not supported"),
+        (b"ply\nformat ascii 1.0\nformat ascii 1.0\nend_header\n", "test.ply:3: a second format line"),
         (b"ply\nformat ascii 1.0\nproperty float x\nend_header\n", "test.ply:3: a property before any element"),
+        (b"ply\nformat ascii 1.0\nelement face 0\nproperty list uchar vertex_indices\nend_header\n", "test.ply:4: a list property line is `property list COUNT_TYPE ITEM_TYPE NAME`"),
         (b"ply\nformat ascii 1.0\nelement vertex 1\nproperty half x\nend_header\n", "test.ply:4: unknown property type \"half\""),
         (b"ply\nformat ascii 1.0\nelement vertex -1\nend_header\n", "test.ply:3: element count \"-1\" is not a whole number"),
         (b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nend_header\n0 0\n", "test.ply:3: element vertex has no property z"),
@@ -403,4 +405,151 @@ fn headers_of_many_names_load_quickly_and_are_warned_about_in_a_line() {
         ),
     ];
     assert_eq!(scene.warnings, expected);
+}
+
+#[test]
+fn every_type_is_read_by_both_its_names() {
+    // Files name their types the old way (`uchar`) or the new (`uint8`, as Open3D and trimesh
+    // write): each of the sixteen names, as positions and, for the integer types, as the face's
+    // count and corners. A binary face of one-byte corners ends the file with no byte to spare.
+    // Writes a small whole number as a value of the type.
+    type Write = fn(u8) -> Value;
+    let types: [(&str, &str, Write, bool); 8] = [
+        ("char", "int8", Value::U8, true),
+        ("uchar", "uint8", Value::U8, true),
+        ("short", "int16", |v| Value::I16(v.into()), true),
+        ("ushort", "uint16", |v| Value::I16(v.into()), true),
+        ("int", "int32", |v| Value::I32(v.into()), true),
+        ("uint", "uint32", |v| Value::U32(v.into()), true),
+        ("float", "float32", |v| Value::F32(v.into()), false),
+        ("double", "float64", |v| Value::F64(v.into()), false),
+    ];
+    for (old, new, value, integer) in types {
+        for name in [old, new] {
+            let (list, corner) = if integer { (name, value) } else { ("uchar", Value::U8 as Write) };
+            let header = format!(
+                "element vertex 3\nproperty {name} x\nproperty {name} y\nproperty {name} z\n\
+                 element face 1\nproperty list {list} {list} vertex_indices\n"
+            );
+            let mut rows: Vec<Vec<Value>> =
+                [[0, 0, 0], [5, 0, 0], [0, 7, 0]].iter().map(|p| p.map(value).to_vec()).collect();
+            rows.push([3, 0, 1, 2].map(corner).to_vec());
+            for format in FORMATS {
+                let scene = parse(&ply(format, &header, &rows));
+                let expected = vec![Vec3::ZERO, Vec3::new(5.0, 0.0, 0.0), Vec3::new(0.0, 7.0, 0.0)];
+                assert_eq!(scene.mesh.positions, expected, "{name}, {}", format.name());
+                assert_eq!(scene.mesh.indices, vec![[0, 1, 2]], "{name}, {}", format.name());
+            }
+        }
+    }
+}
+
+#[test]
+fn elements_not_read_are_skipped_wherever_they_stand() {
+    // Edges between the vertices and the faces, with values of several characters (an ASCII
+    // element is skipped value by value: its fewest bytes would stop mid-line), and an element
+    // after the faces, which must not be read as faces.
+    let header = format!(
+        "element vertex 3\n{XYZ}element edge 2\nproperty int vertex1\nproperty int vertex2\nproperty float crease\n\
+         element face 1\n{FACES}element material 1\nproperty float shininess\n"
+    );
+    let edge = |a, b| vec![Value::I32(a), Value::I32(b), Value::F32(0.25)];
+    let rows = vec![
+        xyz([0.0, 0.0, 0.0]),
+        xyz([1.0, 0.0, 0.0]),
+        xyz([0.0, 1.0, 0.0]),
+        edge(0, 1),
+        edge(1, 2),
+        face(&[0, 1, 2]),
+        vec![Value::F32(12.5)],
+    ];
+    for format in FORMATS {
+        let scene = parse(&ply(format, &header, &rows));
+        assert_eq!(scene.mesh.indices, vec![[0, 1, 2]], "{}", format.name());
+        let expected = "test.ply: elements not read (lumiere reads vertex and face): \"edge\" (2), \"material\" (1)";
+        assert_eq!(scene.warnings, [expected], "{}", format.name());
+    }
+}
+
+#[test]
+fn warnings_name_what_is_not_read_only_where_there_are_values() {
+    // One unread property is named alone (no "and 0 more"); an element, or the properties of an
+    // element, with no instances hold nothing that is lost, so they go unmentioned.
+    let header = format!(
+        "element vertex 3\n{XYZ}property uchar confidence\nelement face 0\n{FACES}property uchar flags\n\
+         element camera 0\nproperty float focal\nelement material 1\nproperty uchar kind\n"
+    );
+    let vertex = |p| [xyz(p), vec![Value::U8(9)]].concat();
+    let rows = vec![vertex([0.0, 0.0, 0.0]), vertex([1.0, 0.0, 0.0]), vertex([0.0, 1.0, 0.0]), vec![Value::U8(2)]];
+    for format in FORMATS {
+        let scene = parse(&ply(format, &header, &rows));
+        assert_eq!(scene.mesh.positions.len(), 3);
+        let expected = [
+            "test.ply:3: vertex properties not read: \"confidence\"",
+            "test.ply: elements not read (lumiere reads vertex and face): \"material\" (1)",
+        ];
+        assert_eq!(scene.warnings, expected, "{}", format.name());
+    }
+}
+
+#[test]
+fn a_body_as_short_as_its_header_allows_is_read_and_one_byte_shorter_refused() {
+    // A point cloud of one-digit values: an ASCII file need not end its last line, a binary one
+    // holds its values and nothing more.
+    let header = format!("element vertex 3\n{XYZ}");
+    let rows = [xyz([0.0, 0.0, 0.0]), xyz([1.0, 0.0, 0.0]), xyz([0.0, 1.0, 0.0])];
+    for format in FORMATS {
+        let mut bytes = ply(format, &header, &rows);
+        if format == Format::Ascii {
+            assert_eq!(bytes.pop(), Some(b'\n'));
+        }
+        assert_eq!(parse(&bytes).mesh.positions.len(), 3, "{}", format.name());
+    }
+    // A binary file cut after its vertices: the element it has no byte for is named by its line.
+    let header = format!("element vertex 3\n{XYZ}element face 1\n{FACES}");
+    for format in [Format::Little, Format::Big] {
+        assert_eq!(
+            parse_error(&ply(format, &header, &rows)),
+            "test.ply:7: element \"face\" declares 1 of them, more than the 36 bytes after the header can hold"
+        );
+    }
+}
+
+#[test]
+fn the_memory_check_counts_the_triangles_of_polygons() {
+    // One face of a hundred corners is 98 triangles and their BVH, about 18 kB: past the 10 kB
+    // given here, though a check of the one face alone would let it through.
+    let n = 100;
+    let header = format!("element vertex {n}\n{XYZ}element face 1\n{FACES}");
+    let mut rows: Vec<Vec<Value>> = (0..n)
+        .map(|k| {
+            let angle = std::f32::consts::TAU * k as f32 / n as f32;
+            xyz([angle.cos(), angle.sin(), 0.0])
+        })
+        .collect();
+    rows.push(face(&(0..n).collect::<Vec<i32>>()));
+    let bytes = ply(Format::Little, &header, &rows);
+    let error = parse_ply_with_memory(&bytes, Path::new("big.ply"), 10_000).unwrap_err().to_string();
+    assert!(error.starts_with("big.ply: needs about"), "{error}");
+    assert!(error.contains("for its 98 triangles and 100 vertices (mesh and BVH)"), "{error}");
+    let scene = parse_ply_with_memory(&bytes, Path::new("big.ply"), 1 << 20).unwrap();
+    assert_eq!(scene.mesh.triangle_count(), 98);
+}
+
+#[test]
+fn a_list_past_the_end_in_an_element_not_read_is_refused_where_it_starts() {
+    // A binary body skips an unread list in one step: a count past the bytes left is a short
+    // file, named at the list's first value, not a jump past the end.
+    let header =
+        format!("element vertex 3\n{XYZ}element face 1\n{FACES}element edge 1\nproperty list uchar int verts\n");
+    let rows = [xyz([0.0, 0.0, 0.0]), xyz([1.0, 0.0, 0.0]), xyz([0.0, 1.0, 0.0]), face(&[0, 1, 2]), face(&[0; 200])];
+    for format in [Format::Little, Format::Big] {
+        let mut bytes = ply(format, &header, &rows);
+        // The edge's count, then one of its two hundred corners.
+        let at = bytes.len() - 200 * 4;
+        bytes.truncate(at + 4);
+        let expected =
+            format!("test.ply: byte {at}: element \"edge\": the file ends before the values its header declares");
+        assert_eq!(parse_error(&bytes), expected, "{}", format.name());
+    }
 }
