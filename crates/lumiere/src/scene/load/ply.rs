@@ -330,7 +330,7 @@ fn read_corners(
     // Every corner takes a byte or more, so a count past the bytes left is a short file, not a
     // reason to reserve gigabytes.
     if length > body.remaining() as u64 {
-        return Err("the file ends before the values its header declares".to_string());
+        return Err(body::SHORT.to_string());
     }
     let length = u32::try_from(length).map_err(|_| format!("a face of {length} corners"))?;
     corners.try_reserve(length as usize).map_err(|_| format!("no memory left for a face of {length} corners"))?;

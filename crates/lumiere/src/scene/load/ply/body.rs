@@ -187,4 +187,4 @@ impl<'a> Body<'a> {
     }
 }
 
-const SHORT: &str = "the file ends before the values its header declares";
+pub(super) const SHORT: &str = "the file ends before the values its header declares";
