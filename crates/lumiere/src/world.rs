@@ -87,11 +87,11 @@ impl World {
         let lights = LightSet::new(&scene);
         let kinds = scene.materials.iter().map(Material::kind).collect();
         let (texture_of_material, textures, mut warnings) =
-            TextureSet::for_materials(scene.materials.iter().map(|m| m.map_kd.as_deref()));
+            TextureSet::for_materials(scene.materials.iter().map(|m| m.map_kd.as_deref()), &scene.embedded_images);
         let texture_of_material = placed(texture_of_material, scene.materials.iter().map(|m| m.map_kd_transform));
         warnings.extend(scene.materials.iter().filter_map(Material::ignored_mask_warning));
         let (cutout_of_material, cutouts, cutout_warnings) =
-            TextureSet::for_cutouts(scene.materials.iter().map(Material::cutout_mask));
+            TextureSet::for_cutouts(scene.materials.iter().map(Material::cutout_mask), &scene.embedded_images);
         warnings.extend(cutout_warnings);
         let cutout_of_material = placed(cutout_of_material, scene.materials.iter().map(|m| m.map_d_transform));
         let diameter = scene.bounds().extent().length();

@@ -103,8 +103,9 @@ pub struct BenchBvhArgs {
 
 #[derive(Args, Debug)]
 pub struct InfoArgs {
-    /// Scene file: Wavefront OBJ (.obj or .obj.gz) with its MTL files, or PLY (.ply or .ply.gz);
-    /// the built-in scene when omitted.
+    /// Scene file: Wavefront OBJ (.obj) with its MTL files, glTF 2.0 (.gltf with its buffers and
+    /// images, or .glb) or PLY (.ply), each also gzipped (.obj.gz, ...); the built-in scene when
+    /// omitted.
     pub scene: Option<PathBuf>,
 }
 
@@ -151,8 +152,9 @@ pub enum LightSamplingArg {
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// Scene file: Wavefront OBJ (.obj or .obj.gz) with its MTL files, or PLY (.ply or .ply.gz);
-    /// the built-in gKit Cornell box when omitted.
+    /// Scene file: Wavefront OBJ (.obj) with its MTL files, glTF 2.0 (.gltf with its buffers and
+    /// images, or .glb) or PLY (.ply), each also gzipped (.obj.gz, ...); the built-in gKit Cornell
+    /// box when omitted.
     pub scene: Option<PathBuf>,
 
     /// What to compute per pixel: path tracing, or one of the lab's steps.

@@ -33,7 +33,7 @@ pub fn run(args: &InfoArgs) -> Result<()> {
         output::warn(warning);
     }
     let (map_kd, map_d) = (materials.iter().map(|m| m.map_kd.as_deref()), materials.iter().map(Material::cutout_mask));
-    for warning in TextureSet::unreadable_files(map_kd, map_d) {
+    for warning in TextureSet::unreadable_files(map_kd, map_d, &scene.embedded_images) {
         output::warn(warning);
     }
     let lights = LightSet::new(&scene);

@@ -309,6 +309,117 @@ fn a_ply_scene_renders_as_its_obj_twin() {
     assert!(images[0] == images[1], "the PLY's image differs from the OBJ's");
 }
 
+/// A GLB file (its texture embedded) renders as the OBJ file of the same quad and light with the
+/// same PBR statements and a texture file does, byte for byte, path-traced: the same triangles,
+/// materials, texture coordinates and texels.
+#[test]
+fn a_glb_scene_renders_as_its_obj_twin() {
+    let dir = TempDir::new("gltf-twin");
+    // The texture: any PNG; lumiere's own render of the box serves.
+    let texture = dir.path("tex.png");
+    let made = lumiere(&["render", "--mode", "hits", "--size", "4x4", "-o", texture.to_str().unwrap()]);
+    assert!(made.status.success(), "{}", stderr(&made));
+    let png = fs::read(&texture).unwrap();
+    let corners = [
+        [-1.0f32, 0.0, -1.0],
+        [1.0, 0.0, -1.0],
+        [1.0, 0.0, 1.0],
+        [-1.0, 0.0, 1.0],
+        [0.0, 1.0, 0.5],
+        [-0.5, 1.0, -0.5],
+        [0.5, 1.0, -0.5],
+    ];
+    // OBJ's v up from the image's bottom; glTF's down from its top (values whose 1 - v is exact).
+    let uv = [[0.0f32, 0.0], [1.0, 0.0], [1.0, 0.75], [0.25, 1.0]];
+    let mut obj = String::from("mtllib twin.mtl\n");
+    for [x, y, z] in corners {
+        obj += &format!("v {x} {y} {z}\n");
+    }
+    for [u, v] in uv {
+        obj += &format!("vt {u} {v}\n");
+    }
+    obj += "usemtl floor\nf 1/1 2/2 3/3 4/4\nusemtl lamp\nf 5 6 7\n";
+    dir.write("twin.obj", obj);
+    dir.write(
+        "twin.mtl",
+        "newmtl floor\nKd 1 1 1\nPm 0\nPr 0.5\nmap_Kd tex.png\nnewmtl lamp\nKd 0 0 0\nKe 5 5 5\nPm 0\nPr 1\n",
+    );
+    let mut bin: Vec<u8> = corners.iter().flatten().flat_map(|c| c.to_le_bytes()).collect();
+    bin.extend(uv.iter().flat_map(|[u, v]| [*u, 1.0 - v]).flat_map(|c| c.to_le_bytes()));
+    bin.extend([0u16, 1, 2, 0, 2, 3, 0, 1, 2].iter().flat_map(|i| i.to_le_bytes()));
+    bin.extend([0u8; 2]);
+    let image_at = bin.len();
+    bin.extend(&png);
+    while !bin.len().is_multiple_of(4) {
+        bin.push(0);
+    }
+    let json = format!(
+        r#"{{"asset": {{"version": "2.0"}}, "scene": 0, "scenes": [{{"nodes": [0]}}], "nodes": [{{"mesh": 0}}],
+        "meshes": [{{"primitives": [
+            {{"attributes": {{"POSITION": 0, "TEXCOORD_0": 1}}, "indices": 2, "material": 0}},
+            {{"attributes": {{"POSITION": 3}}, "indices": 4, "material": 1}}]}}],
+        "materials": [
+            {{"name": "floor", "pbrMetallicRoughness": {{"metallicFactor": 0, "roughnessFactor": 0.5, "baseColorTexture": {{"index": 0}}}}}},
+            {{"name": "lamp", "pbrMetallicRoughness": {{"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0}}, "emissiveFactor": [1, 1, 1],
+              "extensions": {{"KHR_materials_emissive_strength": {{"emissiveStrength": 5}}}}}}],
+        "extensionsUsed": ["KHR_materials_emissive_strength"],
+        "textures": [{{"source": 0}}], "images": [{{"bufferView": 3, "mimeType": "image/png"}}],
+        "buffers": [{{"byteLength": {}}}],
+        "bufferViews": [{{"buffer": 0, "byteLength": 48}}, {{"buffer": 0, "byteOffset": 84, "byteLength": 32}},
+            {{"buffer": 0, "byteOffset": 116, "byteLength": 18}}, {{"buffer": 0, "byteOffset": {image_at}, "byteLength": {}}},
+            {{"buffer": 0, "byteOffset": 48, "byteLength": 36}}],
+        "accessors": [
+            {{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3"}},
+            {{"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC2"}},
+            {{"bufferView": 2, "componentType": 5123, "count": 6, "type": "SCALAR"}},
+            {{"bufferView": 4, "componentType": 5126, "count": 3, "type": "VEC3"}},
+            {{"bufferView": 2, "byteOffset": 12, "componentType": 5123, "count": 3, "type": "SCALAR"}}]}}"#,
+        bin.len(),
+        png.len()
+    );
+    let mut json = json.into_bytes();
+    while !json.len().is_multiple_of(4) {
+        json.push(b' ');
+    }
+    let mut glb = b"glTF".to_vec();
+    glb.extend(2u32.to_le_bytes());
+    glb.extend(((12 + 8 + json.len() + 8 + bin.len()) as u32).to_le_bytes());
+    glb.extend((json.len() as u32).to_le_bytes());
+    glb.extend(b"JSON");
+    glb.extend(&json);
+    glb.extend((bin.len() as u32).to_le_bytes());
+    glb.extend(b"BIN\0");
+    glb.extend(&bin);
+    dir.write("twin.glb", glb);
+    let mut images = Vec::new();
+    for name in ["twin.obj", "twin.glb"] {
+        let scene = dir.path(name);
+        let out = dir.arg(&format!("{name}.pfm"));
+        let args = [
+            "render",
+            scene.to_str().unwrap(),
+            "--spp",
+            "4",
+            "--size",
+            "32x24",
+            "--eye",
+            "0,2,3",
+            "--target",
+            "0,0,0",
+            "-o",
+            &out,
+        ];
+        let run = lumiere(&args);
+        assert!(run.status.success(), "{name}: {}", stderr(&run));
+        assert_eq!(stderr(&run).matches("warning").count(), 0, "{name}: {}", stderr(&run));
+        images.push(fs::read(&out).unwrap());
+    }
+    assert!(images[0] == images[1], "the GLB's image differs from the OBJ's");
+    // Cut short inside its binary chunk: refused, naming the file and the chunk.
+    let cut = dir.write("cut.glb", &fs::read(dir.path("twin.glb")).unwrap()[..200]);
+    assert_refused(&dir, &["render", cut.to_str().unwrap()], "cut.glb: GLB: the header gives a length of");
+}
+
 #[test]
 fn bad_inputs_give_a_clear_error_and_no_file() {
     let dir = TempDir::new("bad");

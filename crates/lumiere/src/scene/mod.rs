@@ -13,6 +13,7 @@ use glam::Vec3;
 use crate::error::{Error, Result, shown_name};
 use crate::materials::Material;
 use crate::math::Aabb;
+use crate::textures::EmbeddedImages;
 use mesh::TriangleMesh;
 
 /// A loaded scene: triangles in file order and their materials. Lights, the BVH and everything
@@ -24,9 +25,12 @@ pub struct Scene {
     pub materials: Vec<Material>,
     /// Non-fatal problems met while loading (missing MTL, unknown material), for the user to see.
     pub warnings: Vec<String>,
-    /// The files read besides the scene file itself (material libraries), so that no output ever
-    /// overwrites one; textures are named by their materials.
+    /// The files read besides the scene file itself (material libraries, glTF buffers), so that
+    /// no output ever overwrites one; textures are named by their materials.
     pub sources: Vec<std::path::PathBuf>,
+    /// The images the scene file carries inside itself (glTF), under the names its materials'
+    /// `map_kd` give them in place of a file's path.
+    pub embedded_images: EmbeddedImages,
 }
 
 impl Scene {
@@ -35,11 +39,13 @@ impl Scene {
         load::load(path)
     }
 
-    /// The files read besides the scene file itself: the material libraries, then every texture
-    /// the materials name (`map_Kd`, `map_d`), whether or not it could be decoded. No output may
-    /// overwrite one (`util::overwrite::check_scene_files`).
+    /// The files read besides the scene file itself: the material libraries or buffers, then every
+    /// texture file the materials name (`map_Kd`, `map_d`; not the images embedded in the scene
+    /// file), whether or not it could be decoded. No output may overwrite one
+    /// (`util::overwrite::check_scene_files`).
     pub fn files_read(&self) -> impl Iterator<Item = &Path> {
         let textures = self.materials.iter().flat_map(|m| [m.map_kd.as_deref(), m.map_d.as_deref()]).flatten();
+        let textures = textures.filter(|texture| !self.embedded_images.contains(texture));
         self.sources.iter().map(PathBuf::as_path).chain(textures)
     }
 
@@ -92,7 +98,7 @@ impl Scene {
                 warnings.push(format!("{name}: material {}: {clamped}", shown_name(&material.name)));
             }
         }
-        Ok(Scene { name, mesh, materials, warnings, sources: Vec::new() })
+        Ok(Scene { name, mesh, materials, warnings, sources: Vec::new(), embedded_images: EmbeddedImages::default() })
     }
 
     /// Sets the emission of every material called `name`.

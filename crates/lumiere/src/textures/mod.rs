@@ -30,6 +30,11 @@
 //! let bsdf = material.bsdf(base);
 //! ```
 
+mod embedded;
+
+pub use embedded::EmbeddedImages;
+
+use std::borrow::Cow;
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -417,19 +422,23 @@ impl TextureSet {
     /// that decoded, with one warning for each path that did not, in the order of `paths`:
     /// `texture "PATH": REASON; the material's Kd is used instead`.
     pub fn load<P: AsRef<Path> + Sync>(paths: &[P]) -> (TextureSet, Vec<String>) {
-        TextureSet::load_or(paths, WITHOUT_DIFFUSE)
+        TextureSet::load_or(paths, WITHOUT_DIFFUSE, &EmbeddedImages::default())
     }
 
     /// [`TextureSet::load`] with `available` bytes of memory, instead of what the system reports
     /// ([`crate::util::read::available_memory`]): for tests of a machine short of memory.
     pub fn load_with_memory<P: AsRef<Path> + Sync>(paths: &[P], available: u64) -> (TextureSet, Vec<String>) {
-        TextureSet::load_within(paths, WITHOUT_DIFFUSE, Some(available))
+        TextureSet::load_within(paths, WITHOUT_DIFFUSE, Some(available), &EmbeddedImages::default())
     }
 
     /// [`TextureSet::load`], whose warnings end with `instead` (what the material does without
-    /// the texture).
-    fn load_or<P: AsRef<Path> + Sync>(paths: &[P], instead: &str) -> (TextureSet, Vec<String>) {
-        TextureSet::load_within(paths, instead, crate::util::read::available_memory())
+    /// the texture), reading the names of `embedded` images from it instead of from files.
+    fn load_or<P: AsRef<Path> + Sync>(
+        paths: &[P],
+        instead: &str,
+        embedded: &EmbeddedImages,
+    ) -> (TextureSet, Vec<String>) {
+        TextureSet::load_within(paths, instead, crate::util::read::available_memory(), embedded)
     }
 
     /// [`TextureSet::load_or`] with `available` bytes of memory (`None`: not known). Each file is
@@ -441,6 +450,7 @@ impl TextureSet {
         paths: &[P],
         instead: &str,
         available: Option<u64>,
+        embedded: &EmbeddedImages,
     ) -> (TextureSet, Vec<String>) {
         let mut distinct: Vec<&Path> = Vec::new();
         for path in paths {
@@ -449,8 +459,7 @@ impl TextureSet {
             }
         }
         let mut left = available;
-        let read: Vec<Result<(Vec<u8>, Header), String>> =
-            distinct.iter().map(|path| read_within(path, &mut left)).collect();
+        let read: Vec<_> = distinct.iter().map(|path| read_within(path, embedded, &mut left)).collect();
         let decoded: Vec<Result<(Texture, u64), String>> = read
             .into_par_iter()
             .map(|file| file.and_then(|(bytes, header)| Ok((header.decode(&bytes)?, hash_bytes(&bytes)))))
@@ -471,29 +480,34 @@ impl TextureSet {
     }
 
     /// The textures of a scene's materials: give each material's diffuse texture path (`map_kd`,
-    /// already resolved relative to its MTL file), get for each material the id of its texture
-    /// (`None` for no texture or one that failed), the set, and the warnings of [`TextureSet::load`].
+    /// already resolved relative to its MTL file, or the name of one of the scene's `embedded`
+    /// images), get for each material the id of its texture (`None` for no texture or one that
+    /// failed), the set, and the warnings of [`TextureSet::load`].
     pub fn for_materials<'a>(
         map_kd: impl IntoIterator<Item = Option<&'a Path>>,
+        embedded: &EmbeddedImages,
     ) -> (Vec<Option<TextureId>>, TextureSet, Vec<String>) {
-        TextureSet::per_material(map_kd, WITHOUT_DIFFUSE)
+        TextureSet::per_material(map_kd, WITHOUT_DIFFUSE, embedded)
     }
 
     /// As [`TextureSet::for_materials`], for each material's coverage texture (`map_d`, for
     /// cutouts): a file that fails leaves its material opaque.
     pub fn for_cutouts<'a>(
         map_d: impl IntoIterator<Item = Option<&'a Path>>,
+        embedded: &EmbeddedImages,
     ) -> (Vec<Option<TextureId>>, TextureSet, Vec<String>) {
-        TextureSet::per_material(map_d, WITHOUT_COVERAGE)
+        TextureSet::per_material(map_d, WITHOUT_COVERAGE, embedded)
     }
 
     /// The warnings [`TextureSet::for_materials`] and [`TextureSet::for_cutouts`] would give
     /// for the files among `map_kd` and `map_d` that are missing, not regular files or too
     /// large: the checks that need no decoding, so they cost no more than a file's metadata
-    /// (what `lumiere info` shows).
+    /// (what `lumiere info` shows). Images `embedded` in the scene file are not files: they are
+    /// checked when they are decoded.
     pub fn unreadable_files<'a>(
         map_kd: impl IntoIterator<Item = Option<&'a Path>>,
         map_d: impl IntoIterator<Item = Option<&'a Path>>,
+        embedded: &EmbeddedImages,
     ) -> Vec<String> {
         let mut warnings = Vec::new();
         for (paths, instead) in
@@ -501,7 +515,7 @@ impl TextureSet {
         {
             let mut seen: Vec<&Path> = Vec::new();
             for path in paths.into_iter().flatten() {
-                if seen.contains(&path) {
+                if seen.contains(&path) || embedded.contains(path) {
                     continue;
                 }
                 seen.push(path);
@@ -518,10 +532,11 @@ impl TextureSet {
     fn per_material<'a>(
         paths: impl IntoIterator<Item = Option<&'a Path>>,
         instead: &str,
+        embedded: &EmbeddedImages,
     ) -> (Vec<Option<TextureId>>, TextureSet, Vec<String>) {
         let paths: Vec<Option<&Path>> = paths.into_iter().collect();
         let distinct: Vec<&Path> = paths.iter().flatten().copied().collect();
-        let (set, warnings) = TextureSet::load_or(&distinct, instead);
+        let (set, warnings) = TextureSet::load_or(&distinct, instead, embedded);
         let ids = paths.iter().map(|path| path.and_then(|p| set.id_of(p))).collect();
         (ids, set, warnings)
     }
@@ -590,11 +605,21 @@ fn check_file(path: &Path) -> Result<(), String> {
     Ok(())
 }
 
-/// Reads one texture file and its header, and sets aside from `left` (bytes of memory, where
-/// known) what the file and its decoding take; the error is a reason without the file name.
-fn read_within(path: &Path, left: &mut Option<u64>) -> Result<(Vec<u8>, Header), String> {
-    check_file(path)?;
-    let bytes = crate::util::read::read_regular_file(path).map_err(|e| e.to_string())?;
+/// Reads one texture file (or takes the bytes of an image `embedded` under that name) and its
+/// header, and sets aside from `left` (bytes of memory, where known) what the file and its
+/// decoding take; the error is a reason without the file name.
+fn read_within<'e>(
+    path: &Path,
+    embedded: &'e EmbeddedImages,
+    left: &mut Option<u64>,
+) -> Result<(Cow<'e, [u8]>, Header), String> {
+    let bytes = match embedded.get(path) {
+        Some(bytes) => Cow::Borrowed(bytes),
+        None => {
+            check_file(path)?;
+            Cow::Owned(crate::util::read::read_regular_file(path).map_err(|e| e.to_string())?)
+        }
+    };
     let header = Header::read(&bytes, Some(path))?;
     if let Some(left) = left {
         let needed = bytes.len() as u64 + header.decoding_bytes();

@@ -16,7 +16,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ("geometry", &["math"]),
     ("materials", &["error", "math", "sampling"]),
     ("accel", &["geometry", "math"]),
-    ("scene", &["error", "materials", "math", "util"]),
+    ("scene", &["error", "materials", "math", "textures", "util"]),
     ("lights", &["geometry", "math", "sampling", "scene", "util"]),
     ("world", &["accel", "geometry", "lights", "materials", "math", "scene", "textures", "util"]),
     (

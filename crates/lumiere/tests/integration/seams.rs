@@ -532,7 +532,7 @@ fn scene_files_are_loaded_by_extension_or_refused_naming_it() {
     assert_eq!(Scene::load(&obj).unwrap().mesh.triangle_count(), 1);
     for (name, expected) in [
         ("model.stl", ".stl scenes are not supported"),
-        ("model.gltf", ".gltf scenes are not supported"),
+        ("model.fbx", ".fbx scenes are not supported"),
         ("noextension", "no extension"),
         // Not "no extension": the name has one, and what it lacks is the one inside.
         ("scene.gz", "a gzip file whose name does not say what it holds"),
@@ -540,12 +540,15 @@ fn scene_files_are_loaded_by_extension_or_refused_naming_it() {
         let path = dir.write(name, "v 0 0 0\n");
         let message = Scene::load(&path).unwrap_err().to_string();
         assert!(message.contains(expected) && message.contains(name), "{name}: {message}");
-        assert!(message.contains(".obj") && message.contains(".ply"), "the message names what is supported: {message}");
+        let supported = [".obj", ".gltf", ".glb", ".ply"];
+        assert!(supported.iter().all(|s| message.contains(s)), "the message names what is supported: {message}");
     }
     // The extension chooses the loader, and the loader checks what the file holds.
     let obj_text = dir.write("model.ply", "v 0 0 0\n");
     let message = Scene::load(&obj_text).unwrap_err().to_string();
     assert!(message.ends_with("model.ply:1: not a PLY file: its first line is not \"ply\""), "{message}");
+    let message = Scene::load(&dir.write("model.gltf", "v 0 0 0\n")).unwrap_err().to_string();
+    assert!(message.ends_with("model.gltf: not glTF JSON: expected value at line 1 column 1"), "{message}");
 }
 
 #[test]

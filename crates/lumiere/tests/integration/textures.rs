@@ -9,7 +9,7 @@ use glam::{Vec2, Vec3};
 use image::{ImageFormat, Rgb, RgbImage, Rgba, RgbaImage};
 use lumiere::render::fingerprint::scene_fingerprint;
 use lumiere::scene::Scene;
-use lumiere::textures::{MAX_TEXELS, Texture, TextureSet, srgb_to_linear};
+use lumiere::textures::{EmbeddedImages, MAX_TEXELS, Texture, TextureSet, srgb_to_linear};
 use lumiere::util::hash::hash_bytes;
 use lumiere::world::World;
 
@@ -334,7 +334,8 @@ fn unusable_files_cost_one_warning_each_and_no_texture() {
         Some(folder),
         Some(missing.clone()),
     ];
-    let (ids, set, warnings) = TextureSet::for_materials(map_kd.iter().map(|p| p.as_deref()));
+    let (ids, set, warnings) =
+        TextureSet::for_materials(map_kd.iter().map(|p| p.as_deref()), &EmbeddedImages::default());
     assert_eq!(set.len(), 1, "the good file, decoded once");
     let good_id = set.id_of(&good).unwrap();
     assert_eq!(set.contents_hash(good_id), hash_bytes(&std::fs::read(&good).unwrap()));
@@ -349,7 +350,7 @@ fn unusable_files_cost_one_warning_each_and_no_texture() {
     assert!(warnings[4].contains("not a regular file"), "{}", warnings[4]);
     // A path with a control character (from an MTL line) is escaped, never printed raw.
     let odd = dir.path("odd\u{1b}[2Jname.png");
-    let (_, _, warnings) = TextureSet::for_materials([Some(odd.as_path())]);
+    let (_, _, warnings) = TextureSet::for_materials([Some(odd.as_path())], &EmbeddedImages::default());
     assert!(warnings[0].contains("odd\\u{1b}[2Jname.png") && !warnings[0].contains('\u{1b}'), "{}", warnings[0]);
 }
 

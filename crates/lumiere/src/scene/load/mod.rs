@@ -1,6 +1,7 @@
 //! Scene files in: the loader is chosen by the file's extension, and every loader hands its
 //! triangles, materials and warnings to [`Scene::from_parts`]. Loaders know nothing of rendering.
 
+pub mod gltf;
 pub mod memory;
 pub mod obj;
 pub mod ply;
@@ -14,7 +15,8 @@ use crate::scene::Scene;
 use crate::util::read::refuse_special;
 
 /// The scene formats lumiere reads, named as in messages.
-const SUPPORTED: &str = ".obj (with its .mtl files) or .ply, either also gzipped (.obj.gz, .ply.gz)";
+const SUPPORTED: &str =
+    ".obj (with its .mtl files), .gltf (with its buffers and images), .glb or .ply, each also gzipped (.obj.gz, ...)";
 
 /// Loads the scene file at `path`, choosing the loader by its extension (case-insensitive).
 pub fn load(path: &Path) -> Result<Scene> {
@@ -29,12 +31,13 @@ pub fn load(path: &Path) -> Result<Scene> {
     match extension.as_str() {
         "obj" => obj::load_obj(path)?.into_scene(shown_path(path)),
         "ply" => ply::load_ply(path),
+        "gltf" | "glb" => gltf::load_gltf(path),
         "mtl" => Err(Error::invalid(format!(
             "{}: is a material library (.mtl), not a scene; give the .obj file that names it with mtllib",
             shown_path(path)
         ))),
         "" if stem.len() < name.len() => Err(Error::invalid(format!(
-            "{}: a gzip file whose name does not say what it holds; name a compressed scene .obj.gz or .ply.gz",
+            "{}: a gzip file whose name does not say what it holds; name a compressed scene .obj.gz, .gltf.gz, .glb.gz or .ply.gz",
             shown_path(path)
         ))),
         "" => Err(Error::invalid(format!(

@@ -1,0 +1,362 @@
+//! glTF 2.0 loading (`.gltf` with its buffers and images, or `.glb`): the format of Khronos'
+//! sample models, Sketchfab's downloads and Blender's, three.js' and most engines' exports.
+//!
+//! Read: the scene's node tree with every node's transform (`nodes.rs`); each mesh primitive of
+//! triangles, strips or fans, with `POSITION`, `NORMAL` (as shading normals) and the texture
+//! coordinates its material's base colour texture reads (`TEXCOORD_n`, `v` flipped to OBJ's
+//! bottom-up convention), indexed or not, quantised (`KHR_mesh_quantization`) or sparse
+//! (`accessor.rs`); the metallic-roughness materials with their base colour textures, glass from
+//! `KHR_materials_transmission`, and emission (`materials.rs`). A node whose transform mirrors
+//! (negative determinant) has its triangles' corners swapped, so that a face keeps its front.
+//! Anything else (points and lines, cameras, skins, animations, morph targets, unsupported
+//! extensions and material properties) is named in a warning, never silently dropped; a file that
+//! *requires* an extension lumiere does not read is refused.
+//!
+//! Every byte range is checked before it is read, and the whole flattened scene is refused before
+//! its triangles are allocated when its mesh and BVH would not fit in the memory left (instancing
+//! lets a small file draw a mesh a million times).
+
+mod accessor;
+mod buffers;
+mod container;
+mod materials;
+mod nodes;
+mod uri;
+
+use crate::error::{Error, Result, quote, shown_path};
+use crate::materials::Material;
+use crate::scene::Scene;
+use crate::scene::load::memory::{Memory, MeshSize, check_mesh_memory};
+use crate::scene::load::warnings::Warnings;
+use crate::scene::mesh::{NO_INDEX, TriangleMesh};
+use crate::textures::EmbeddedImages;
+use crate::util::read;
+use accessor::BufferData;
+pub use buffers::ReadFile;
+use glam::{DMat3, DMat4, Vec2, Vec3};
+use gltf::accessor::Dimensions;
+use gltf::mesh::{Mode, Semantic};
+pub use materials::DEFAULT_NAME;
+use nodes::Instance;
+use std::path::{Path, PathBuf};
+use std::rc::Rc;
+
+/// Loads `path` (`.gltf` or `.glb`, either also gzipped), reading the buffers it names beside it.
+pub fn load_gltf(path: &Path) -> Result<Scene> {
+    let bytes = read::read_input(path).map_err(|error| Error::io(path, error))?;
+    parse_gltf(&bytes, path, &|file| read::read_regular_file(file))
+}
+
+/// Parses a glTF file's bytes; `name` names it in messages and locates the files it names, which
+/// `read` reads (buffers; images are named for the renderer to decode).
+pub fn parse_gltf(bytes: &[u8], name: &Path, read: ReadFile) -> Result<Scene> {
+    parse_within(bytes, name, read, Memory::System)
+}
+
+/// [`parse_gltf`] as if `available` bytes of memory were left, so that tests can check the refusal
+/// of scenes too big for memory without allocating gigabytes.
+#[doc(hidden)]
+pub fn parse_gltf_with_memory(bytes: &[u8], name: &Path, read: ReadFile, available: u64) -> Result<Scene> {
+    parse_within(bytes, name, read, Memory::Given(available))
+}
+
+fn parse_within(bytes: &[u8], file: &Path, read: ReadFile, memory: Memory) -> Result<Scene> {
+    let container = container::parse(bytes, file)?;
+    let document = &container.document;
+    let mut warnings = Warnings::default();
+    warn_unread(document, file, &mut warnings);
+    let buffers = buffers::load(&container, file, read)?;
+    let instances = nodes::instances(document, file, &mut warnings)?;
+    let meshes: Vec<gltf::Mesh> = document.meshes().collect();
+
+    let mut embedded = EmbeddedImages::default();
+    let mut image_path = |image: &gltf::Image| image_source(image, &buffers.data, file, &mut embedded);
+    let converted: Vec<_> =
+        document.materials().map(|m| materials::convert(&m, file, &mut image_path, &mut warnings)).collect();
+    let mut materials: Vec<Material> = Vec::with_capacity(converted.len() + 1);
+    let mut texcoord_sets = Vec::with_capacity(converted.len() + 1);
+    for converted in converted {
+        materials.push(converted.material);
+        texcoord_sets.push(converted.texcoord_set);
+    }
+    // glTF's default material, for primitives that name none, only where one is drawn.
+    let default_id = materials.len();
+    let drawn = instances.iter().flat_map(|instance| meshes[instance.mesh].primitives());
+    if drawn.filter(|p| is_triangles(p.mode())).any(|p| p.material().index().is_none()) {
+        let default = materials::default_material();
+        materials.push(default.material);
+        texcoord_sets.push(default.texcoord_set);
+    }
+
+    let size = counted(&meshes, &instances, &texcoord_sets, file, &mut warnings)?;
+    let held = buffers.data.iter().map(|data| data.len() as u64).sum();
+    check_mesh_memory(file, size, held, memory, "mesh and BVH, beside the file's buffers")?;
+
+    let mut mesh = TriangleMesh::default();
+    let mut decoded: Vec<Option<Rc<Vec<Primitive>>>> = vec![None; document.meshes().len()];
+    for instance in &instances {
+        let primitives = match &decoded[instance.mesh] {
+            Some(primitives) => Rc::clone(primitives),
+            None => {
+                let source = &meshes[instance.mesh];
+                let primitives = Rc::new(decode_mesh(source, &buffers.data, &texcoord_sets, default_id, file)?);
+                decoded[instance.mesh] = Some(Rc::clone(&primitives));
+                primitives
+            }
+        };
+        for primitive in primitives.iter() {
+            append(&mut mesh, primitive, instance, size, file)?;
+        }
+    }
+    // Unused: only the materials some triangle draws with, plus the default, would do, but ids are
+    // kept in the file's order so that `--emission NAME` finds every material the file names.
+    let mut scene = Scene::from_parts(shown_path(file), mesh, materials, warnings.finish())?;
+    scene.sources = buffers.files;
+    scene.embedded_images = embedded;
+    Ok(scene)
+}
+
+/// The path a material's texture names for `image`: a file beside the glTF file, or the name
+/// under which its bytes (from a buffer view or a `data:` URI) are added to `embedded`.
+fn image_source(
+    image: &gltf::Image,
+    buffers: BufferData,
+    file: &Path,
+    embedded: &mut EmbeddedImages,
+) -> Result<PathBuf, String> {
+    let bytes: Vec<u8> = match image.source() {
+        gltf::image::Source::Uri { uri, .. } => match uri::resolve(uri, file)? {
+            uri::Uri::File(path) => return Ok(path),
+            uri::Uri::Data(bytes) => bytes,
+        },
+        gltf::image::Source::View { view, .. } => accessor::view_bytes(&view, buffers)?.to_vec(),
+    };
+    let name = EmbeddedImages::name(file, image.index());
+    embedded.add(name.clone(), bytes.into());
+    Ok(name)
+}
+
+/// What the whole scene will hold, counted from the accessors' declared counts before anything is
+/// read; warns about primitives that are not triangles.
+fn counted(
+    meshes: &[gltf::Mesh],
+    instances: &[Instance],
+    texcoord_sets: &[u32],
+    file: &Path,
+    warnings: &mut Warnings,
+) -> Result<MeshSize> {
+    let (mut positions, mut normals, mut texcoords, mut triangles) = (0u64, 0u64, 0u64, 0u64);
+    for instance in instances {
+        for primitive in meshes[instance.mesh].primitives() {
+            let where_ = || format!("{}: mesh {} primitive {}", shown_path(file), instance.mesh, primitive.index());
+            if !is_triangles(primitive.mode()) {
+                warnings.push(file, "primitives not drawn", || {
+                    format!("{}: {:?} are not drawn (lumiere draws triangles)", where_(), primitive.mode())
+                });
+                continue;
+            }
+            let Some(position) = primitive.get(&Semantic::Positions) else {
+                return Err(Error::invalid(format!("{}: no POSITION attribute", where_())));
+            };
+            let vertices = position.count() as u64;
+            let set = primitive.material().index().map_or(0, |material| texcoord_sets[material]);
+            for (semantic, total) in [(Semantic::Normals, &mut normals), (Semantic::TexCoords(set), &mut texcoords)] {
+                if let Some(attribute) = primitive.get(&semantic) {
+                    if attribute.count() != position.count() {
+                        return Err(Error::invalid(format!(
+                            "{}: {} has {} elements, POSITION {}",
+                            where_(),
+                            semantic.to_string(),
+                            attribute.count(),
+                            position.count()
+                        )));
+                    }
+                    *total = total.saturating_add(vertices);
+                }
+            }
+            positions = positions.saturating_add(vertices);
+            let corners = primitive.indices().map_or(vertices, |indices| indices.count() as u64);
+            triangles = triangles.saturating_add(triangle_count(primitive.mode(), corners));
+        }
+    }
+    let clamp = |n: u64| usize::try_from(n).unwrap_or(usize::MAX);
+    Ok(MeshSize { positions: clamp(positions), normals: clamp(normals), texcoords: clamp(texcoords), triangles })
+}
+
+fn is_triangles(mode: Mode) -> bool {
+    matches!(mode, Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan)
+}
+
+/// The triangles `corners` vertices make in `mode`.
+fn triangle_count(mode: Mode, corners: u64) -> u64 {
+    match mode {
+        Mode::Triangles => corners / 3,
+        _ => corners.saturating_sub(2),
+    }
+}
+
+/// One primitive's vertices and triangles in its mesh's coordinates.
+struct Primitive {
+    positions: Vec<Vec3>,
+    normals: Option<Vec<Vec3>>,
+    texcoords: Option<Vec<Vec2>>,
+    triangles: Vec<[u32; 3]>,
+    material: u32,
+}
+
+fn decode_mesh(
+    mesh: &gltf::Mesh,
+    buffers: BufferData,
+    texcoord_sets: &[u32],
+    default_id: usize,
+    file: &Path,
+) -> Result<Vec<Primitive>> {
+    let mut primitives = Vec::new();
+    for primitive in mesh.primitives().filter(|p| is_triangles(p.mode())) {
+        let fail = |what: String, accessor: &gltf::Accessor, reason: String| {
+            Error::invalid(format!(
+                "{}: mesh {} primitive {}: {what} (accessor {}): {reason}",
+                shown_path(file),
+                mesh.index(),
+                primitive.index(),
+                accessor.index()
+            ))
+        };
+        let read_attribute = |semantic: Semantic, dimensions| {
+            primitive
+                .get(&semantic)
+                .map(|accessor| {
+                    accessor::read_floats::<3>(&accessor, dimensions, buffers)
+                        .map_err(|reason| fail(semantic.to_string(), &accessor, reason))
+                })
+                .transpose()
+        };
+        let positions = read_attribute(Semantic::Positions, Dimensions::Vec3)?.expect("counted: POSITION is there");
+        let positions: Vec<Vec3> = positions.into_iter().map(Vec3::from).collect();
+        if let Some(bad) = positions.iter().position(|p| !p.is_finite()) {
+            let accessor = primitive.get(&Semantic::Positions).expect("read above");
+            return Err(fail("POSITION".into(), &accessor, format!("element {bad} is not finite")));
+        }
+        let normals = read_attribute(Semantic::Normals, Dimensions::Vec3)?.map(|normals| {
+            normals.into_iter().map(Vec3::from).map(|n| if n.is_finite() { n } else { Vec3::ZERO }).collect()
+        });
+        let material = primitive.material().index().unwrap_or(default_id);
+        let set = texcoord_sets[material];
+        let texcoords = match primitive.get(&Semantic::TexCoords(set)) {
+            Some(accessor) => Some(
+                accessor::read_floats::<2>(&accessor, Dimensions::Vec2, buffers)
+                    .map_err(|reason| fail(format!("TEXCOORD_{set}"), &accessor, reason))?
+                    .into_iter()
+                    .map(|[u, v]| Vec2::new(u, 1.0 - v))
+                    .collect(),
+            ),
+            None => None,
+        };
+        let corners = match primitive.indices() {
+            Some(accessor) => {
+                let corners = accessor::read_indices(&accessor, buffers)
+                    .map_err(|reason| fail("indices".into(), &accessor, reason))?;
+                if let Some(&bad) = corners.iter().find(|&&i| i as usize >= positions.len()) {
+                    let reason = format!("index {bad} out of range: POSITION has {} elements", positions.len());
+                    return Err(fail("indices".into(), &accessor, reason));
+                }
+                corners
+            }
+            None => (0..positions.len() as u32).collect(),
+        };
+        let triangles = assemble(primitive.mode(), &corners);
+        primitives.push(Primitive { positions, normals, texcoords, triangles, material: material as u32 });
+    }
+    Ok(primitives)
+}
+
+/// The triangles of a primitive's corners: a list in threes (a leftover corner or two dropped), a
+/// strip with every other triangle's first two corners swapped to keep its winding, or a fan.
+fn assemble(mode: Mode, corners: &[u32]) -> Vec<[u32; 3]> {
+    match mode {
+        Mode::Triangles => corners.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+        Mode::TriangleStrip => corners
+            .windows(3)
+            .enumerate()
+            .map(|(i, c)| if i % 2 == 0 { [c[0], c[1], c[2]] } else { [c[1], c[0], c[2]] })
+            .collect(),
+        _ => corners.get(1..).unwrap_or_default().windows(2).map(|c| [corners[0], c[0], c[1]]).collect(),
+    }
+}
+
+/// Appends `primitive` as `instance` places it. The mesh gets normal and texture coordinate
+/// indices as soon as the scene has any (`size` counted them): corners without are [`NO_INDEX`].
+fn append(
+    mesh: &mut TriangleMesh,
+    primitive: &Primitive,
+    instance: &Instance,
+    size: MeshSize,
+    file: &Path,
+) -> Result<()> {
+    let base = mesh.positions.len() as u32;
+    let transform: DMat4 = instance.transform;
+    for (i, &p) in primitive.positions.iter().enumerate() {
+        let placed = transform.transform_point3(p.as_dvec3()).as_vec3();
+        if !placed.is_finite() {
+            return Err(Error::invalid(format!(
+                "{}: node {} places vertex {i} of mesh {} at a position that is not finite in single precision",
+                shown_path(file),
+                instance.node,
+                instance.mesh
+            )));
+        }
+        mesh.positions.push(placed);
+    }
+    // A mirroring transform turns counter-clockwise corners clockwise: swap two to keep the front.
+    let mirrored = transform.determinant() < 0.0;
+    let oriented = |[a, b, c]: [u32; 3]| if mirrored { [a, c, b] } else { [a, b, c] };
+    let offset = |base: u32, t: [u32; 3]| oriented(t.map(|i| base + i));
+    mesh.indices.extend(primitive.triangles.iter().map(|&t| offset(base, t)));
+    mesh.material_ids.extend(std::iter::repeat_n(primitive.material, primitive.triangles.len()));
+    if size.normals > 0 {
+        let normal_matrix = DMat3::from_mat4(transform).inverse().transpose();
+        let indices = match &primitive.normals {
+            Some(normals) => {
+                let base = mesh.normals.len() as u32;
+                mesh.normals
+                    .extend(normals.iter().map(|n| (normal_matrix * n.as_dvec3()).normalize_or_zero().as_vec3()));
+                primitive.triangles.iter().map(|&t| offset(base, t)).collect::<Vec<_>>()
+            }
+            None => vec![[NO_INDEX; 3]; primitive.triangles.len()],
+        };
+        mesh.normal_indices.extend(indices);
+    }
+    if size.texcoords > 0 {
+        let indices = match &primitive.texcoords {
+            Some(texcoords) => {
+                let base = mesh.texcoords.len() as u32;
+                mesh.texcoords.extend_from_slice(texcoords);
+                primitive.triangles.iter().map(|&t| offset(base, t)).collect::<Vec<_>>()
+            }
+            None => vec![[NO_INDEX; 3]; primitive.triangles.len()],
+        };
+        mesh.texcoord_indices.extend(indices);
+    }
+    Ok(())
+}
+
+/// Warns, once each, about what the file has that lumiere does not draw.
+fn warn_unread(document: &gltf::Document, file: &Path, warnings: &mut Warnings) {
+    let unread: Vec<String> =
+        document.extensions_used().filter(|used| !container::SUPPORTED_EXTENSIONS.contains(used)).map(quote).collect();
+    if !unread.is_empty() {
+        let list = unread.join(", ");
+        warnings.push(file, "extensions not read", || format!("{}: extensions not read: {list}", shown_path(file)));
+    }
+    let morphs = document.meshes().flat_map(|m| m.primitives()).any(|p| p.morph_targets().len() > 0);
+    for (count, what) in [
+        (document.cameras().len(), "cameras (frame the view with --eye and --target)"),
+        (document.skins().len(), "skins (meshes are drawn in their bind pose)"),
+        (document.animations().len(), "animations (the scene is drawn at rest)"),
+        (usize::from(morphs), "morph targets (meshes are drawn without them)"),
+    ] {
+        if count > 0 {
+            warnings.push(file, "features not read", || format!("{}: not read: {what}", shown_path(file)));
+        }
+    }
+}

@@ -1,0 +1,156 @@
+//! glTF materials as lumiere's [`Material`]: the metallic-roughness model onto the MTL PBR
+//! extension's mapping (a metal from `metallic ≥ 0.5`, otherwise a plastic with a 4% layer;
+//! GGX `α = roughness²`), `KHR_materials_transmission` onto smooth glass of `KHR_materials_ior`'s
+//! index, emission from `emissiveFactor` (times `KHR_materials_emissive_strength`), and the base
+//! colour texture with its placement. What is not honoured is named in one warning per material.
+//! docs/MATERIALS.md has the table.
+
+use crate::error::{shown_name, shown_path};
+use crate::materials::Material;
+use crate::math::UvTransform;
+use crate::scene::load::warnings::Warnings;
+use glam::{Vec2, Vec3};
+use std::path::{Path, PathBuf};
+
+/// The name of the material of primitives that name none: glTF's default material (white, fully
+/// metallic and rough), named as an OBJ face without `usemtl` names its material.
+pub const DEFAULT_NAME: &str = "default";
+
+/// Transmission from which a material is drawn as glass: lumiere's dielectric transmits all or
+/// nothing, so a weight is rounded to the nearer.
+const GLASS_FROM_TRANSMISSION: f32 = 0.5;
+
+/// Finds the file a glTF image is in (or names its embedded bytes); the error is a reason.
+pub(super) type ImagePath<'r> = &'r mut dyn FnMut(&gltf::Image) -> Result<PathBuf, String>;
+
+/// A glTF material as lumiere draws it, and the texture coordinate set (`TEXCOORD_n`) its base
+/// colour texture reads.
+pub(super) struct Converted {
+    pub(super) material: Material,
+    pub(super) texcoord_set: u32,
+}
+
+/// glTF's default material, of primitives that name none: white, metallic and rough.
+pub(super) fn default_material() -> Converted {
+    let mut material = Material::default_grey(DEFAULT_NAME);
+    (material.kd, material.metallic, material.roughness) = (Vec3::ONE, Some(1.0), Some(1.0));
+    Converted { material, texcoord_set: 0 }
+}
+
+/// Converts `source`, warning (about `file`) about what is not honoured; `index` names an unnamed
+/// material (`material3`).
+pub(super) fn convert(
+    source: &gltf::Material,
+    file: &Path,
+    image_path: ImagePath,
+    warnings: &mut Warnings,
+) -> Converted {
+    let name = match (source.name(), source.index()) {
+        (Some(name), _) => name.to_string(),
+        (None, index) => format!("material{}", index.unwrap_or_default()),
+    };
+    let mut material = Material::default_grey(&name);
+    let mut not_read: Vec<String> = Vec::new();
+    let pbr = source.pbr_metallic_roughness();
+    let [r, g, b, _] = pbr.base_color_factor();
+    material.kd = Vec3::new(r, g, b);
+    material.metallic = Some(pbr.metallic_factor());
+    material.roughness = Some(pbr.roughness_factor());
+    let mut texcoord_set = 0;
+    if let Some(info) = pbr.base_color_texture() {
+        match base_colour_texture(&info, image_path, &mut not_read) {
+            Ok((path, transform, set)) => {
+                if material.kd != Vec3::ONE {
+                    not_read.push("baseColorFactor under baseColorTexture (the texture is used alone)".to_string());
+                }
+                material.map_kd = Some(path);
+                material.map_kd_transform = transform;
+                texcoord_set = set;
+            }
+            Err(reason) => warnings.push(file, "base colour textures not read", || {
+                format!(
+                    "{}: material {}: baseColorTexture not read: {reason}; baseColorFactor is used instead",
+                    shown_path(file),
+                    shown_name(&name)
+                )
+            }),
+        }
+    }
+    if let Some(transmission) = source.transmission()
+        && transmission.transmission_factor() >= GLASS_FROM_TRANSMISSION
+    {
+        // Glass: the PBR fields would make it a metal or a plastic (see `Material::kind`).
+        (material.metallic, material.roughness) = (None, None);
+        material.illum = 7;
+        material.ni = source.ior().unwrap_or(crate::materials::DEFAULT_IOR);
+        material.tf = material.kd;
+        if transmission.transmission_texture().is_some() {
+            not_read.push("transmissionTexture".to_string());
+        }
+        if pbr.roughness_factor() > 0.0 {
+            not_read.push("roughness under transmission (the glass is smooth)".to_string());
+        }
+    } else if source.ior().is_some_and(|ior| ior != crate::materials::DEFAULT_IOR) {
+        not_read.push("KHR_materials_ior without transmission (the specular layer reflects 4%)".to_string());
+    }
+    let strength = source.emissive_strength().unwrap_or(1.0);
+    material.ke = Vec3::from(source.emissive_factor()) * strength;
+    if source.emissive_texture().is_some() && material.is_emissive() {
+        // A texture that paints a screen or a lamp's bulb on a surface: emitting its factor over
+        // the whole surface would light the scene with what is mostly dark.
+        material.ke = Vec3::ZERO;
+        not_read
+            .push("emissiveTexture (the material does not emit; --emission NAME=R,G,B makes it a light)".to_string());
+    }
+    for (present, what) in [
+        (pbr.metallic_roughness_texture().is_some(), "metallicRoughnessTexture"),
+        (source.normal_texture().is_some(), "normalTexture"),
+        (source.occlusion_texture().is_some(), "occlusionTexture"),
+        (source.alpha_mode() == gltf::material::AlphaMode::Mask, "alphaMode MASK (drawn opaque)"),
+        (source.alpha_mode() == gltf::material::AlphaMode::Blend, "alphaMode BLEND (drawn opaque)"),
+    ] {
+        if present {
+            not_read.push(what.to_string());
+        }
+    }
+    if !not_read.is_empty() {
+        let list = not_read.join(", ");
+        warnings.push(file, "material properties not read", || {
+            format!("{}: material {}: not read: {list}", shown_path(file), shown_name(&name))
+        });
+    }
+    Converted { material, texcoord_set }
+}
+
+/// The base colour texture's file, placement and coordinate set; what is not honoured of it goes
+/// onto `not_read`.
+fn base_colour_texture(
+    info: &gltf::texture::Info,
+    image_path: ImagePath,
+    not_read: &mut Vec<String>,
+) -> Result<(PathBuf, UvTransform, u32), String> {
+    let texture = info.texture();
+    let path = image_path(&texture.source())?;
+    let sampler = texture.sampler();
+    if sampler.wrap_s() != gltf::texture::WrappingMode::Repeat
+        || sampler.wrap_t() != gltf::texture::WrappingMode::Repeat
+    {
+        not_read.push("the sampler's wrapping (textures repeat)".to_string());
+    }
+    let mut set = info.tex_coord();
+    let mut transform = UvTransform::default();
+    if let Some(placement) = info.texture_transform() {
+        set = placement.tex_coord().unwrap_or(set);
+        if placement.rotation() != 0.0 {
+            not_read.push("KHR_texture_transform's rotation".to_string());
+        }
+        transform = flipped(Vec2::from(placement.scale()), Vec2::from(placement.offset()));
+    }
+    Ok((path, transform, set))
+}
+
+/// A placement `uv · scale + offset` in glTF's coordinates (`v` down from the image's top) as one in
+/// lumiere's, where `v` runs up from the bottom as in OBJ (the loader reads `v` as `1 − v`).
+fn flipped(scale: Vec2, offset: Vec2) -> UvTransform {
+    UvTransform { scale, offset: Vec2::new(offset.x, 1.0 - offset.y - scale.y) }
+}
