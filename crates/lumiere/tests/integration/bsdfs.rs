@@ -12,7 +12,7 @@ use glam::{DVec3, Vec2, Vec3};
 use lumiere::materials::fresnel::{
     dielectric_f0, fresnel_dielectric, fresnel_dielectric_polarised, fresnel_schlick, refracted_cos,
 };
-use lumiere::materials::microfacet::{Ggx, MIN_ALPHA, reflect};
+use lumiere::materials::microfacet::{Ggx, MAX_ALPHA, MIN_ALPHA, reflect};
 use lumiere::materials::{
     Bsdf, BsdfFlags, Conductor, DEFAULT_IOR, Dielectric, Lambert, Material, MaterialBsdf, MaterialKind, Mirror,
     Plastic, alpha_from_ns,
@@ -122,6 +122,32 @@ fn glossy_lobes() -> Vec<(String, MaterialBsdf)> {
 
 // ---------------------------------------------------------------------------------------------
 // GGX
+
+/// `Ggx::new` keeps a roughness in [`MIN_ALPHA`, `MAX_ALPHA`] exactly and clamps the rest to the
+/// nearer end, a NaN to the roughest, as it documents; `alpha()` reports the roughness kept. The
+/// lobe tests read `alpha()` only to choose integration steps and, in the slow
+/// `pdfs_integrate_to_at_most_one`, the expected `∫ pdf`: an `alpha()` returning a constant passed
+/// every other fast test.
+#[test]
+fn ggx_keeps_its_roughness_within_range_and_clamps_the_rest() {
+    for alpha in [MIN_ALPHA, 0.05, 0.3, 0.8, MAX_ALPHA] {
+        assert_eq!(Ggx::new(alpha).alpha(), alpha, "α {alpha} is in range");
+    }
+    let clamped = [
+        (0.0, MIN_ALPHA),
+        (-0.5, MIN_ALPHA),
+        (MIN_ALPHA.next_down(), MIN_ALPHA),
+        (f32::NEG_INFINITY, MIN_ALPHA),
+        (MAX_ALPHA.next_up(), MAX_ALPHA),
+        (4.0, MAX_ALPHA),
+        (f32::INFINITY, MAX_ALPHA),
+        (f32::NAN, MAX_ALPHA),
+    ];
+    for (given, kept) in clamped {
+        assert_eq!(Ggx::new(given).alpha(), kept, "α {given}");
+        assert_eq!(Ggx::new(given), Ggx::new(kept), "α {given}");
+    }
+}
 
 /// `∫ D(m) cos θm dωm = 1`: the projected microfacet area equals the macro-surface's. Integrated
 /// in `θ` through `tan θ = α tan(πx/2)`, which spreads the peak of small `α` over the interval.
