@@ -147,6 +147,38 @@ def test_a_binary_ply_file_renders_as_the_same_arrays(tmp_path):
         lumiere.load(ply)
 
 
+def test_a_gltf_file_loads_pickles_and_renders(tmp_path):
+    # A .gltf with its buffer beside it, as numpy writes one: its materials by name for emission,
+    # the same bits after a pickle (which reloads the file), and a cut buffer named in the error.
+    import json
+
+    vertices = np.array([[-1, 0, -1], [1, 0, -1], [0, 0, 1], [-1, 2, -1], [1, 2, -1], [0, 2, 1]], dtype="<f4")
+    indices = np.array([0, 2, 1, 3, 4, 5], dtype="<u2")
+    data = vertices.tobytes() + indices.tobytes()
+    (tmp_path / "two data.bin").write_bytes(data)
+    document = {
+        "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0, "translation": [0, 0.5, 0]}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}],
+        "materials": [{"name": "panel", "pbrMetallicRoughness": {"metallicFactor": 0}}],
+        "buffers": [{"uri": "two%20data.bin", "byteLength": len(data)}],
+        "bufferViews": [{"buffer": 0, "byteLength": 72}, {"buffer": 0, "byteOffset": 72, "byteLength": 12}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 6, "type": "VEC3"},
+                      {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"}],
+    }
+    path = tmp_path / "two.gltf"
+    path.write_text(json.dumps(document))
+    scene = lumiere.load(path, emission={"panel": (1, 1, 1)})
+    assert scene.warnings == [] and scene.info()["triangles"] == 2
+    camera = lumiere.Camera.look_at((0, 1, 4), (0, 1, 0), size=(16, 12))
+    image = lumiere.render(scene, camera, spp=2)
+    assert image.max() > 0
+    assert np.array_equal(bits(image), bits(lumiere.render(pickle.loads(pickle.dumps(scene)), camera, spp=2)))
+    (tmp_path / "two data.bin").write_bytes(data[:-3])
+    with pytest.raises(lumiere.LumiereError, match=r"two\.gltf: buffer 0: declares 84 bytes, but its data has 81"):
+        lumiere.load(path)
+
+
 def grey_png(path, values):
     """A one-row 8-bit grey PNG of `values`, written without an imaging library."""
     import struct

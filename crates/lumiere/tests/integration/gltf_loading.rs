@@ -396,9 +396,9 @@ fn what_is_not_drawn_is_named_in_warnings() {
     let primitive = quad(&mut builder);
     let points = primitive.replace(r#""indices""#, r#""mode": 0, "indices""#);
     let rest = format!(
-        r#""meshes": [{{"primitives": [{primitive}, {points}]}}], "nodes": [{{"mesh": 0}}, {{"camera": 0}}],
+        r#""meshes": [{{"primitives": [{primitive}, {points}]}}], "nodes": [{{"mesh": 0}}, {{"camera": 0}}, {{"mesh": 0}}],
         "cameras": [{{"type": "perspective", "perspective": {{"yfov": 0.8, "znear": 0.1}}}}],
-        "scenes": [{{"nodes": [0, 1]}}, {{"name": "other", "nodes": []}}], "scene": 0,
+        "scenes": [{{"nodes": [0, 1, 2]}}, {{"name": "other", "nodes": []}}], "scene": 0,
         "materials": [{{"name": "rough", "normalTexture": {{"index": 0}}, "alphaMode": "BLEND",
             "emissiveFactor": [1, 1, 1], "emissiveTexture": {{"index": 0}}}}],
         "textures": [{{"source": 0}}], "images": [{{"uri": "n.png"}}],
@@ -406,7 +406,7 @@ fn what_is_not_drawn_is_named_in_warnings() {
     );
     let rest = rest.replacen(r#""indices""#, r#""material": 0, "indices""#, 1);
     let scene = parse(&builder.gltf(&rest));
-    assert_eq!(scene.mesh.triangle_count(), 2, "the points are not drawn");
+    assert_eq!(scene.mesh.triangle_count(), 4, "the points are not drawn, by either node");
     assert!(!scene.materials[0].is_emissive(), "an emissive texture is not painted as its factor over the surface");
     let expected = [
         r#"test.gltf: extensions not read: "KHR_materials_clearcoat", "KHR_lights_punctual""#,
@@ -572,10 +572,35 @@ fn indices_out_of_range_and_bad_sparse_substitutions_are_refused() {
     let sparse = format!(
         r#", "sparse": {{"count": 1, "indices": {{"bufferView": {sparse_indices}, "componentType": {UNSIGNED_BYTE}}}, "values": {{"bufferView": {sparse_values}}}}}"#
     );
+    let texcoords = builder.floats(&[0., 0., 1., 0., f32::INFINITY, 1.], "VEC2");
+    let error = parse_error(
+        &builder
+            .gltf(&one_mesh(&format!(r#"{{"attributes": {{"POSITION": {positions}, "TEXCOORD_0": {texcoords}}}}}"#))),
+    );
+    assert_eq!(error, "test.gltf: mesh 0 primitive 0: TEXCOORD_0 (accessor 2): element 2 is not finite");
     let moved = builder.accessor(None, 0, FLOAT, 3, "VEC3", &sparse);
     let error = parse_error(&builder.gltf(&one_mesh(&format!(r#"{{"attributes": {{"POSITION": {moved}}}}}"#))));
     assert_eq!(
         error,
-        "test.gltf: mesh 0 primitive 0: POSITION (accessor 2): sparse index 5 out of range: the accessor has 3 elements"
+        "test.gltf: mesh 0 primitive 0: POSITION (accessor 3): sparse index 5 out of range: the accessor has 3 elements"
+    );
+}
+
+#[test]
+fn a_texture_placement_that_is_not_finite_is_left_out_with_a_warning() {
+    let mut builder = Builder::default();
+    let primitive = quad(&mut builder).replace(r#""indices""#, r#""material": 0, "indices""#);
+    let rest = format!(
+        r#"{}, "images": [{{"uri": "a.png"}}], "textures": [{{"source": 0}}],
+        "materials": [{{"name": "far", "pbrMetallicRoughness": {{"baseColorTexture": {{"index": 0,
+            "extensions": {{"KHR_texture_transform": {{"scale": [1e39, 1]}}}}}}}}}}],
+        "extensionsUsed": ["KHR_texture_transform"]"#,
+        one_mesh(&primitive)
+    );
+    let scene = parse(&builder.gltf(&rest));
+    assert!(scene.materials[0].map_kd_transform.is_identity());
+    assert_eq!(
+        scene.warnings,
+        ["test.gltf: material 'far': not read: KHR_texture_transform with numbers that are not finite"]
     );
 }

@@ -146,10 +146,15 @@ fn counted(
     warnings: &mut Warnings,
 ) -> Result<MeshSize> {
     let (mut positions, mut normals, mut texcoords, mut triangles) = (0u64, 0u64, 0u64, 0u64);
+    let mut warned = vec![false; meshes.len()];
     for instance in instances {
+        let first_instance = !std::mem::replace(&mut warned[instance.mesh], true);
         for primitive in meshes[instance.mesh].primitives() {
             let where_ = || format!("{}: mesh {} primitive {}", shown_path(file), instance.mesh, primitive.index());
             if !is_triangles(primitive.mode()) {
+                if !first_instance {
+                    continue;
+                }
                 warnings.push(file, "primitives not drawn", || {
                     format!("{}: {:?} are not drawn (lumiere draws triangles)", where_(), primitive.mode())
                 });
@@ -243,13 +248,16 @@ fn decode_mesh(
         let material = primitive.material().index().unwrap_or(default_id);
         let set = texcoord_sets[material];
         let texcoords = match primitive.get(&Semantic::TexCoords(set)) {
-            Some(accessor) => Some(
-                accessor::read_floats::<2>(&accessor, Dimensions::Vec2, buffers)
-                    .map_err(|reason| fail(format!("TEXCOORD_{set}"), &accessor, reason))?
-                    .into_iter()
-                    .map(|[u, v]| Vec2::new(u, 1.0 - v))
-                    .collect(),
-            ),
+            Some(accessor) => {
+                let what = || format!("TEXCOORD_{set}");
+                let values = accessor::read_floats::<2>(&accessor, Dimensions::Vec2, buffers)
+                    .map_err(|reason| fail(what(), &accessor, reason))?;
+                // As in OBJ, where a `vt` that is not finite is refused: a lookup needs a place.
+                if let Some(bad) = values.iter().position(|uv| !uv.iter().all(|c| c.is_finite())) {
+                    return Err(fail(what(), &accessor, format!("element {bad} is not finite")));
+                }
+                Some(values.into_iter().map(|[u, v]| Vec2::new(u, 1.0 - v)).collect())
+            }
             None => None,
         };
         let corners = match primitive.indices() {

@@ -144,7 +144,12 @@ fn base_colour_texture(
         if placement.rotation() != 0.0 {
             not_read.push("KHR_texture_transform's rotation".to_string());
         }
-        transform = flipped(Vec2::from(placement.scale()), Vec2::from(placement.offset()));
+        let placed = flipped(Vec2::from(placement.scale()), Vec2::from(placement.offset()));
+        if placed.scale.is_finite() && placed.offset.is_finite() {
+            transform = placed;
+        } else {
+            not_read.push("KHR_texture_transform with numbers that are not finite".to_string());
+        }
     }
     Ok((path, transform, set))
 }
