@@ -84,17 +84,18 @@ impl Builder {
     /// buffer at `uri` (none: the GLB binary chunk).
     fn json(&self, rest: &str, uri: Option<&str>) -> String {
         let uri = uri.map(|u| format!(r#", "uri": "{u}""#)).unwrap_or_default();
-        let buffers = if self.blob.is_empty() {
-            String::new()
-        } else {
-            format!(
-                r#""buffers": [{{"byteLength": {}{uri}}}], "bufferViews": [{}], "accessors": [{}], "#,
+        let mut members = String::new();
+        if !self.blob.is_empty() {
+            members += &format!(
+                r#""buffers": [{{"byteLength": {}{uri}}}], "bufferViews": [{}], "#,
                 self.blob.len(),
-                self.views.join(", "),
-                self.accessors.join(", ")
-            )
-        };
-        format!(r#"{{"asset": {{"version": "2.0"}}, {buffers}{rest}}}"#)
+                self.views.join(", ")
+            );
+        }
+        if !self.accessors.is_empty() {
+            members += &format!(r#""accessors": [{}], "#, self.accessors.join(", "));
+        }
+        format!(r#"{{"asset": {{"version": "2.0"}}, {members}{rest}}}"#)
     }
 
     fn gltf(&self, rest: &str) -> Vec<u8> {
@@ -388,6 +389,24 @@ fn a_mesh_is_drawn_once_per_node_and_a_scene_instanced_past_memory_is_refused() 
     assert!(error.starts_with("test.gltf: needs about "), "{error}");
     assert!(error.contains("for its 200 triangles and 400 vertices"), "{error}");
     assert!(parse_gltf_with_memory(&bytes, Path::new("test.gltf"), &no_files, 1 << 30).is_ok());
+    // Vertices past what 32-bit indices reach are refused whatever the memory: 2^30 positions
+    // without a view (zeros but for one sparse substitution), drawn by four nodes.
+    let mut builder = Builder::default();
+    let (indices, values) = (builder.view(&[0u8], None), builder.view(&[0u8; 12], None));
+    let sparse = format!(
+        r#", "sparse": {{"count": 1, "indices": {{"bufferView": {indices}, "componentType": {UNSIGNED_BYTE}}}, "values": {{"bufferView": {values}}}}}"#
+    );
+    let zeros = builder.accessor(None, 0, FLOAT, 1 << 30, "VEC3", &sparse);
+    let rest = format!(
+        r#""meshes": [{{"primitives": [{{"attributes": {{"POSITION": {zeros}}}}}]}}],
+        "nodes": [{{"mesh": 0}}, {{"mesh": 0}}, {{"mesh": 0}}, {{"mesh": 0}}], "scenes": [{{"nodes": [0, 1, 2, 3]}}]"#
+    );
+    let bytes = builder.gltf(&rest);
+    let error = parse_gltf_with_memory(&bytes, Path::new("test.gltf"), &no_files, u64::MAX).unwrap_err();
+    assert_eq!(
+        error.to_string(),
+        "test.gltf: the scene draws 4294967296 vertices, more than the 4294967295 lumiere can index"
+    );
 }
 
 #[test]

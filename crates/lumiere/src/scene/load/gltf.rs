@@ -71,14 +71,13 @@ fn parse_within(bytes: &[u8], file: &Path, read: ReadFile, memory: Memory) -> Re
 
     let mut embedded = EmbeddedImages::default();
     let mut image_path = |image: &gltf::Image| image_source(image, &buffers.data, file, &mut embedded);
-    let converted: Vec<_> =
-        document.materials().map(|m| materials::convert(&m, file, &mut image_path, &mut warnings)).collect();
-    let mut materials: Vec<Material> = Vec::with_capacity(converted.len() + 1);
-    let mut texcoord_sets = Vec::with_capacity(converted.len() + 1);
-    for converted in converted {
-        materials.push(converted.material);
-        texcoord_sets.push(converted.texcoord_set);
-    }
+    // Every material the file defines is kept, drawn or not, at its index in the file, so that
+    // `--emission NAME` finds any of them.
+    let (mut materials, mut texcoord_sets): (Vec<Material>, Vec<u32>) = document
+        .materials()
+        .map(|m| materials::convert(&m, file, &mut image_path, &mut warnings))
+        .map(|converted| (converted.material, converted.texcoord_set))
+        .unzip();
     // glTF's default material, for primitives that name none, only where one is drawn.
     let default_id = materials.len();
     let drawn = instances.iter().flat_map(|instance| meshes[instance.mesh].primitives());
@@ -93,7 +92,7 @@ fn parse_within(bytes: &[u8], file: &Path, read: ReadFile, memory: Memory) -> Re
     check_mesh_memory(file, size, held, memory, "mesh and BVH, beside the file's buffers")?;
 
     let mut mesh = TriangleMesh::default();
-    let mut decoded: Vec<Option<Rc<Vec<Primitive>>>> = vec![None; document.meshes().len()];
+    let mut decoded: Vec<Option<Rc<Vec<Primitive>>>> = vec![None; meshes.len()];
     for instance in &instances {
         let primitives = match &decoded[instance.mesh] {
             Some(primitives) => Rc::clone(primitives),
@@ -108,8 +107,6 @@ fn parse_within(bytes: &[u8], file: &Path, read: ReadFile, memory: Memory) -> Re
             append(&mut mesh, primitive, instance, size, file)?;
         }
     }
-    // Unused: only the materials some triangle draws with, plus the default, would do, but ids are
-    // kept in the file's order so that `--emission NAME` finds every material the file names.
     let mut scene = Scene::from_parts(shown_path(file), mesh, materials, warnings.finish())?;
     scene.sources = buffers.files;
     scene.embedded_images = embedded;
@@ -182,6 +179,17 @@ fn counted(
             positions = positions.saturating_add(vertices);
             let corners = primitive.indices().map_or(vertices, |indices| indices.count() as u64);
             triangles = triangles.saturating_add(triangle_count(primitive.mode(), corners));
+        }
+    }
+    // Corners index vertices with 32 bits: a scene of more vertices (instanced, it takes few bytes
+    // to ask for) is refused here, whatever the memory.
+    for (count, what) in [(positions, "vertices"), (normals, "normals"), (texcoords, "texture coordinates")] {
+        if count > u64::from(u32::MAX) {
+            return Err(Error::invalid(format!(
+                "{}: the scene draws {count} {what}, more than the {} lumiere can index",
+                shown_path(file),
+                u32::MAX
+            )));
         }
     }
     let clamp = |n: u64| usize::try_from(n).unwrap_or(usize::MAX);
