@@ -17,6 +17,7 @@ use lumiere::render::checkpoint::Checkpoint;
 use lumiere::render::{RenderOptions, render};
 use lumiere::scene::Scene;
 use lumiere::scene::camera::{Camera, Orbiter};
+use lumiere::scene::load::gltf::parse_gltf;
 use lumiere::scene::load::obj::{ObjScene, parse_obj, parse_obj_with_chunk_size};
 use lumiere::scene::load::ply::parse_ply;
 use lumiere::scene::mesh::{NO_INDEX, TriangleMesh};
@@ -29,6 +30,8 @@ use std::path::{Path, PathBuf};
 pub const OBJ_NAME: &str = "fuzz.obj";
 /// The name errors must carry in the PLY target.
 pub const PLY_NAME: &str = "fuzz.ply";
+/// The name errors must carry in the glTF target (the loader tells `.glb` from JSON by its magic).
+pub const GLTF_NAME: &str = "fuzz.gltf";
 /// The name parse errors must carry in the orbiter target.
 pub const ORBITER_NAME: &str = "fuzz_orbiter.txt";
 /// The name errors must carry in the checkpoint target.
@@ -38,9 +41,10 @@ pub const CHECKPOINT_NAME: &str = "fuzz.ckpt";
 pub type Target = fn(&[u8]) -> Result<(), String>;
 
 /// Every target, by the name of its `fuzz_targets/*.rs` file and `fuzz/corpus/` folder.
-pub const TARGETS: [(&str, Target); 8] = [
+pub const TARGETS: [(&str, Target); 9] = [
     ("obj", obj_target),
     ("ply", ply_target),
+    ("gltf", gltf_target),
     ("obj_chunks", obj_chunks_target),
     ("mtl", mtl_target),
     ("orbiter", orbiter_target),
@@ -132,6 +136,62 @@ pub fn ply_target(data: &[u8]) -> Result<(), String> {
         Err(error) => check_ply_error(&error, file, data),
     }
 }
+
+/// Target `gltf`: `parse_gltf` on a `.gltf` (JSON) or `.glb` file's bytes, with a reader that
+/// refuses every file it names (buffers must be in the GLB binary chunk or in `data:` URIs).
+pub fn gltf_target(data: &[u8]) -> Result<(), String> {
+    let file = Path::new(GLTF_NAME);
+    let refuse = |path: &Path| Err(io::Error::new(io::ErrorKind::NotFound, format!("no file {}", path.display())));
+    match parse_gltf(data, file, &refuse) {
+        Ok(scene) => check_gltf_scene(&scene, file),
+        Err(error) => check_gltf_error(&error, file),
+    }
+}
+
+/// An accepted glTF scene is consistent and finite like any mesh; no file was read (the reader
+/// refuses them all); every texture named as embedded in the file (`fuzz.gltf#imageN`) is in
+/// `embedded_images`; texture transforms are finite.
+pub fn check_gltf_scene(scene: &Scene, file: &Path) -> Result<(), String> {
+    check_mesh(&scene.mesh, &scene.materials, &scene.warnings)?;
+    if !scene.sources.is_empty() {
+        return Err(format!("files read through a reader that refuses them all: {:?}", scene.sources));
+    }
+    let embedded_prefix = format!("{}#image", file.display());
+    for material in &scene.materials {
+        let transform = &material.map_kd_transform;
+        if !transform.scale.is_finite() || !transform.offset.is_finite() {
+            return Err(format!("material {:?} has a non-finite texture transform: {transform:?}", material.name));
+        }
+        let Some(texture) = &material.map_kd else { continue };
+        let embedded = texture.to_str().is_some_and(|name| name.starts_with(&embedded_prefix));
+        if embedded && !scene.embedded_images.contains(texture) {
+            return Err(format!("material {:?} uses {}, which is not embedded", material.name, texture.display()));
+        }
+    }
+    Ok(())
+}
+
+/// A glTF error is one line that starts with the file's name, and short (a quoted token is cut).
+pub fn check_gltf_error(error: &Error, file: &Path) -> Result<(), String> {
+    let message = error.to_string();
+    if message.contains('\n') {
+        return Err(format!("error message spans several lines: {message:?}"));
+    }
+    if !message.starts_with(&format!("{}: ", file.display())) {
+        return Err(format!("error does not start with \"{}: \": {message}", file.display()));
+    }
+    if message.len() > GLTF_MESSAGE_MAX {
+        return Err(format!(
+            "error message of {} bytes: {}...",
+            message.len(),
+            message.chars().take(200).collect::<String>()
+        ));
+    }
+    Ok(())
+}
+
+/// The longest glTF error message accepted: a few quoted names (80 characters each) and numbers.
+pub const GLTF_MESSAGE_MAX: usize = 1000;
 
 /// Target `scene`, end to end: input as for `obj`; whatever parses must also become a scene, a
 /// BVH and an 8x6 image in every mode (1 sample) without panicking, with finite pixels.

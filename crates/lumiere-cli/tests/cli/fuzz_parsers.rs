@@ -14,8 +14,8 @@
 //! docs/FUZZING.md.
 
 use crate::harness::{
-    checkpoint_target, guarded, mtl_target, obj_chunks_target, obj_target, orbiter_target, ply_target, raw_checkpoint,
-    scene_target, with_checksum,
+    checkpoint_target, gltf_target, guarded, mtl_target, obj_chunks_target, obj_target, orbiter_target, ply_target,
+    raw_checkpoint, scene_target, with_checksum,
 };
 use crate::process::{Limits, TempDir, check_exit, run};
 use proptest::prelude::*;
@@ -38,10 +38,19 @@ const CUBE_PLY: &[u8] = include_bytes!("../corpus/seeds/cube-ascii.ply");
 const HEXAGON_LE_PLY: &[u8] = include_bytes!("../corpus/seeds/hexagon-le.ply");
 const HEXAGON_BE_PLY: &[u8] = include_bytes!("../corpus/seeds/hexagon-be.ply");
 
+// glTF seeds: a `.gltf` with a base64 `data:` buffer (an emissive quad, the default material); a
+// `.glb` with a binary chunk (u16 indices, normals, texture coordinates, a sparse accessor, a PNG in
+// a buffer view, a texture transform, glass); a `.gltf` node tree (TRS, a matrix, a mirror) of
+// strips and fans with u8 indices, interleaved quantised attributes, a viewless accessor, lines.
+const QUAD_GLTF: &[u8] = include_bytes!("../corpus/seeds/quad-data-uri.gltf");
+const TEXTURED_GLB: &[u8] = include_bytes!("../corpus/seeds/textured-sparse.glb");
+const HIERARCHY_GLTF: &[u8] = include_bytes!("../corpus/seeds/hierarchy-strips-fans.gltf");
+
 const OBJS: [&[u8]; 2] = [CORNELL_OBJ, MCGUIRE_OBJ];
 const PLYS: [&[u8]; 3] = [CUBE_PLY, HEXAGON_LE_PLY, HEXAGON_BE_PLY];
 const MTLS: [&[u8]; 2] = [CORNELL_MTL, MCGUIRE_MTL];
 const ORBITERS: [&[u8]; 2] = [ORBITER_2022, ORBITER_2020];
+const GLTFS: [&[u8]; 3] = [QUAD_GLTF, TEXTURED_GLB, HIERARCHY_GLTF];
 
 /// Generous: a parse of a few KB takes microseconds; only a hang (or a quadratic blow-up) gets here.
 const DEADLINE: Duration = Duration::from_secs(10);
@@ -266,6 +275,197 @@ fn token_soup() -> impl Strategy<Value = Vec<u8>> {
     prop::collection::vec(line, 0..40).prop_map(|lines| lines.join(&b'\n'))
 }
 
+/// JSON numbers for glTF: indices and counts at and past every limit, component types and
+/// targets, floats that overflow `f32`, and spellings JSON refuses.
+const JSON_NUMBERS: &[&str] = &[
+    "0",
+    "-0",
+    "-0.0",
+    "1",
+    "-1",
+    "2",
+    "3",
+    "4",
+    "5",
+    "6",
+    "7",
+    "8",
+    "12",
+    "16",
+    "255",
+    "256",
+    "65535",
+    "65536",
+    "2147483647",
+    "2147483648",
+    "-2147483648",
+    "4294967295",
+    "4294967296",
+    "9007199254740993",
+    "9223372036854775807",
+    "18446744073709551615",
+    "18446744073709551616",
+    "-9223372036854775808",
+    "5120",
+    "5121",
+    "5122",
+    "5123",
+    "5125",
+    "5126",
+    "34962",
+    "34963",
+    "0.5",
+    "1e-45",
+    "1e-300",
+    "3.4028235e38",
+    "3.5e38",
+    "-3.5e38",
+    "1e300",
+    "-1e300",
+    "1.7976931348623157e308",
+    "1e400",
+    "1e",
+    "01",
+    "NaN",
+];
+
+/// JSON strings for glTF: accessor types, attribute names, URIs (data, relative, escaping,
+/// percent-encoded, with a scheme), extension names, and odd text.
+const JSON_STRINGS: &[&str] = &[
+    "\"\"",
+    "\"SCALAR\"",
+    "\"VEC2\"",
+    "\"VEC3\"",
+    "\"VEC4\"",
+    "\"MAT2\"",
+    "\"MAT3\"",
+    "\"MAT4\"",
+    "\"POSITION\"",
+    "\"NORMAL\"",
+    "\"TEXCOORD_0\"",
+    "\"TEXCOORD_1\"",
+    "\"TEXCOORD_4294967296\"",
+    "\"COLOR_0\"",
+    "\"_X\"",
+    "\"data:application/octet-stream;base64,\"",
+    "\"data:;base64,AAAAAAAAAAAAAAAA\"",
+    "\"data:,abc\"",
+    "\"data:;base64,%%%\"",
+    "\"x.bin\"",
+    "\"../../etc/passwd\"",
+    "\"/abs/x.bin\"",
+    "\"%41%zz\"",
+    "\"%\"",
+    "\"C:/x.png\"",
+    "\"http://example.com/x.bin\"",
+    "\"image/png\"",
+    "\"image/jpeg\"",
+    "\"KHR_materials_transmission\"",
+    "\"KHR_texture_transform\"",
+    "\"KHR_mesh_quantization\"",
+    "\"KHR_draco_mesh_compression\"",
+    "\"\\u0000\\n\\ud800\"",
+    "\"\u{e9}\"",
+    "[]",
+    "{}",
+    "null",
+    "true",
+];
+
+/// One structural edit of a glTF file's JSON (for a `.glb`, of its JSON chunk).
+#[derive(Clone, Debug)]
+enum JsonEdit {
+    /// Replaces the n-th number (outside strings) with one of [`JSON_NUMBERS`].
+    Number(Index, Index),
+    /// Replaces the n-th string (a key or a value) with one of [`JSON_STRINGS`].
+    Text(Index, Index),
+    /// Replaces the n-th number with a number or string of the same file (an index elsewhere).
+    Copy(Index, Index),
+}
+
+fn json_edit() -> impl Strategy<Value = JsonEdit> {
+    prop_oneof![
+        4 => (any::<Index>(), any::<Index>()).prop_map(|(n, v)| JsonEdit::Number(n, v)),
+        2 => (any::<Index>(), any::<Index>()).prop_map(|(n, v)| JsonEdit::Text(n, v)),
+        1 => (any::<Index>(), any::<Index>()).prop_map(|(n, v)| JsonEdit::Copy(n, v)),
+    ]
+}
+
+/// The byte ranges of the JSON numbers and of the strings (quotes included) in `json`.
+fn json_spans(json: &[u8]) -> (Vec<(usize, usize)>, Vec<(usize, usize)>) {
+    let (mut numbers, mut strings) = (Vec::new(), Vec::new());
+    let mut i = 0;
+    while i < json.len() {
+        match json[i] {
+            b'"' => {
+                let start = i;
+                i += 1;
+                while i < json.len() && json[i] != b'"' {
+                    i += if json[i] == b'\\' { 2 } else { 1 };
+                }
+                i = (i + 1).min(json.len());
+                strings.push((start, i));
+            }
+            b'-' | b'0'..=b'9' => {
+                let start = i;
+                while i < json.len() && matches!(json[i], b'-' | b'+' | b'.' | b'e' | b'E' | b'0'..=b'9') {
+                    i += 1;
+                }
+                numbers.push((start, i));
+            }
+            _ => i += 1,
+        }
+    }
+    (numbers, strings)
+}
+
+fn edit_json(original: &[u8], edits: &[JsonEdit]) -> Vec<u8> {
+    let mut json = original.to_vec();
+    for edit in edits {
+        let (numbers, strings) = json_spans(&json);
+        let (spans, value): (&[(usize, usize)], Vec<u8>) = match edit {
+            JsonEdit::Number(_, v) => (&numbers[..], JSON_NUMBERS[v.index(JSON_NUMBERS.len())].as_bytes().to_vec()),
+            JsonEdit::Text(_, v) => (&strings[..], JSON_STRINGS[v.index(JSON_STRINGS.len())].as_bytes().to_vec()),
+            JsonEdit::Copy(n, v) if !numbers.is_empty() => {
+                let (start, end) = numbers[v.index(numbers.len())];
+                (&numbers[..], json[start..end].to_vec())
+            }
+            JsonEdit::Copy(..) => continue,
+        };
+        let n = match edit {
+            JsonEdit::Number(n, _) | JsonEdit::Text(n, _) | JsonEdit::Copy(n, _) => n,
+        };
+        if !spans.is_empty() {
+            let (start, end) = spans[n.index(spans.len())];
+            json.splice(start..end, value);
+        }
+    }
+    json
+}
+
+/// A `.glb`'s JSON chunk and the rest of the file after it (its other chunks), if it is one.
+fn glb_json(glb: &[u8]) -> Option<(&[u8], &[u8])> {
+    let length = u32::from_le_bytes(glb.get(12..16)?.try_into().ok()?) as usize;
+    Some((glb.get(20..20 + length)?, &glb[20 + length..]))
+}
+
+/// A `.glb` of `json` (padded with spaces to 4 bytes) and the chunks `rest`, lengths recomputed.
+fn rewrapped_glb(json: &[u8], rest: &[u8]) -> Vec<u8> {
+    let mut json = json.to_vec();
+    while !json.len().is_multiple_of(4) {
+        json.push(b' ');
+    }
+    let total = 12 + 8 + json.len() + rest.len();
+    let mut out = b"glTF".to_vec();
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&(total as u32).to_le_bytes());
+    out.extend_from_slice(&(json.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&json);
+    out.extend_from_slice(rest);
+    out
+}
+
 /// `cases` cases, times `FUZZ_CASES_SCALE` when set (to search longer than CI does). The seed is
 /// random per run (proptest's default) unless `PROPTEST_RNG_SEED` is set.
 fn config(cases: u32) -> ProptestConfig {
@@ -346,6 +546,25 @@ proptest! {
     fn ply_random_bodies(file in 0..PLYS.len(), body in prop::collection::vec(any::<u8>(), 0..600)) {
         let header = PLYS[file].windows(11).position(|w| w == b"end_header\n").map_or(0, |at| at + 11);
         check!(ply_target, [&PLYS[file][..header], &body].concat());
+    }
+
+    /// Byte-level edits of the glTF seeds (a `.glb`'s lengths left as they are).
+    #[test]
+    fn gltf_mutated_seeds(file in 0..GLTFS.len(), mutations in prop::collection::vec(mutation(), 1..6)) {
+        let gltf = mutate(GLTFS[file], &mutations, &GLTFS);
+        check!(gltf_target, gltf);
+    }
+
+    /// Structural edits of the seeds' JSON: numbers (indices, counts, offsets, strides, component
+    /// types, factors) and strings (types, attribute names, URIs) replaced, a `.glb` rewrapped
+    /// with its lengths recomputed, so that the edit reaches the loader past the container.
+    #[test]
+    fn gltf_json_edits(file in 0..GLTFS.len(), edits in prop::collection::vec(json_edit(), 1..4)) {
+        let gltf = match glb_json(GLTFS[file]).filter(|_| GLTFS[file].starts_with(b"glTF")) {
+            Some((json, rest)) => rewrapped_glb(&edit_json(json, &edits), rest),
+            None => edit_json(GLTFS[file], &edits),
+        };
+        check!(gltf_target, gltf);
     }
 
     #[test]
