@@ -294,6 +294,58 @@ fn interleaved_quantised_normalised_sparse_and_viewless_accessors_decode() {
     assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
 }
 
+/// Found by fuzzing (`fuzz/`, target `gltf`): the `gltf` crates panicked on these files, which they
+/// assume valid without checking: a `POSITION` accessor index out of range (gltf-json's own
+/// validation indexed the accessors with it: "index out of bounds: the len is 3 but the index is
+/// 3"), and an image without a source, or of a buffer view without a MIME type (`Image::source`
+/// unwraps them: "called `Option::unwrap()` on a `None` value").
+#[test]
+fn files_the_gltf_crates_assume_valid_are_refused_not_panicked_on() {
+    let mut builder = Builder::default();
+    let primitive = quad(&mut builder);
+    let good = one_mesh(&primitive);
+    let textured = |image: &str| {
+        format!(
+            r#"{good}, "materials": [{{"pbrMetallicRoughness": {{"baseColorTexture": {{"index": 0}}}}}}], "textures": [{{"source": 0}}], "images": [{image}]"#
+        )
+    };
+    let cases = [
+        (
+            good.replace(r#""POSITION": 0"#, r#""POSITION": 9"#),
+            "test.gltf: invalid glTF: meshes[0].primitives[0].attributes[\"POSITION\"]: index out of bounds",
+        ),
+        (textured(r#"{"bufferView": 0}"#), "test.gltf: invalid glTF: images[0].mimeType: missing data"),
+        (textured(r#"{"name": "nowhere"}"#), "test.gltf: invalid glTF: images[0].uri: missing data"),
+    ];
+    for (json, expected) in cases {
+        assert_eq!(parse_error(&builder.gltf(&json)), expected);
+        assert_eq!(parse_error(&builder.glb(&json)), expected);
+    }
+    // The same image with its MIME type, or a URI, is read.
+    assert!(
+        parse_gltf(
+            &builder.gltf(&textured(r#"{"bufferView": 0, "mimeType": "image/png"}"#)),
+            Path::new("test.gltf"),
+            &no_files
+        )
+        .is_ok()
+    );
+}
+
+/// Found by fuzzing: serde's message quotes a string of the file whole, so a 3,000-byte value of
+/// the wrong type made a 3,000-byte error line; it is cut in the middle now.
+#[test]
+fn a_long_string_of_the_wrong_type_gives_a_short_error() {
+    let json = format!(r#"{{"asset": {{"version": "2.0"}}, "scene": "{}"}}"#, "a".repeat(3000));
+    let message = parse_error(json.as_bytes());
+    assert!(message.len() < 400, "{} bytes: {message}", message.len());
+    assert!(message.starts_with("test.gltf: not glTF JSON: invalid type: string \"aaaa"), "{message}");
+    assert!(
+        message.ends_with("expected index into child of root at line 1 column 3041 (3080 characters in all)"),
+        "{message}"
+    );
+}
+
 /// A 2×1 PNG: a red texel and a blue one.
 fn png() -> Vec<u8> {
     let image = image::RgbImage::from_raw(2, 1, vec![255, 0, 0, 0, 0, 255]).unwrap();
