@@ -376,6 +376,9 @@ fn materials_map_onto_lumieres_kinds() {
     assert_eq!(scene.materials[0].kd, Vec3::new(0.9, 0.7, 0.3));
     assert_eq!(kinds[1], MaterialKind::Plastic { ks: Vec3::splat(0.04), alpha: 0.25 });
     assert_eq!(kinds[2], MaterialKind::Dielectric { eta: 1.33, tf: Vec3::new(0.9, 1., 1.) });
+    // An index past f32's range reads as infinite: the material keeps the default index instead.
+    let huge = builder.gltf(&format!("{}, {}", one_mesh(&primitives.join(", ")), materials.replace("1.33", "1e39")));
+    assert_eq!(parse(&huge).materials[2].ni, lumiere::materials::DEFAULT_IOR);
     assert_eq!(scene.materials[3].ke, Vec3::new(8., 4., 2.));
     assert_eq!(scene.mesh.material_ids, [0, 0, 1, 1, 2, 2, 3, 3]);
     assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);

@@ -82,7 +82,8 @@ pub(super) fn convert(
         // Glass: the PBR fields would make it a metal or a plastic (see `Material::kind`).
         (material.metallic, material.roughness) = (None, None);
         material.illum = 7;
-        material.ni = source.ior().unwrap_or(crate::materials::DEFAULT_IOR);
+        // An index past f32's range (`"ior": 3.5e38`) reads as infinite: the default is used.
+        material.ni = source.ior().filter(|ior| ior.is_finite()).unwrap_or(crate::materials::DEFAULT_IOR);
         material.tf = material.kd;
         if transmission.transmission_texture().is_some() {
             not_read.push("transmissionTexture".to_string());
