@@ -391,8 +391,11 @@ fn json_edit() -> impl Strategy<Value = JsonEdit> {
     ]
 }
 
+/// Byte ranges `(start, end)` of a file.
+type Spans = Vec<(usize, usize)>;
+
 /// The byte ranges of the JSON numbers and of the strings (quotes included) in `json`.
-fn json_spans(json: &[u8]) -> (Vec<(usize, usize)>, Vec<(usize, usize)>) {
+fn json_spans(json: &[u8]) -> (Spans, Spans) {
     let (mut numbers, mut strings) = (Vec::new(), Vec::new());
     let mut i = 0;
     while i < json.len() {
