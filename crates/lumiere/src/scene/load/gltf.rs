@@ -121,14 +121,17 @@ fn image_source(
     file: &Path,
     embedded: &mut EmbeddedImages,
 ) -> Result<PathBuf, String> {
+    let name = EmbeddedImages::name(file, image.index());
     let bytes: Vec<u8> = match image.source() {
         gltf::image::Source::Uri { uri, .. } => match uri::resolve(uri, file)? {
             uri::Uri::File(path) => return Ok(path),
+            // Materials sharing an image take it once.
+            _ if embedded.contains(&name) => return Ok(name),
             uri::Uri::Data(bytes) => bytes,
         },
+        gltf::image::Source::View { .. } if embedded.contains(&name) => return Ok(name),
         gltf::image::Source::View { view, .. } => accessor::view_bytes(&view, buffers)?.to_vec(),
     };
-    let name = EmbeddedImages::name(file, image.index());
     embedded.add(name.clone(), bytes.into());
     Ok(name)
 }

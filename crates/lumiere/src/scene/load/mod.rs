@@ -8,7 +8,7 @@ pub mod ply;
 mod polygon;
 pub mod warnings;
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result, shown_path};
 use crate::scene::Scene;
@@ -49,5 +49,21 @@ pub fn load(path: &Path) -> Result<Scene> {
             shown_path(path),
             crate::error::quote(other).trim_matches('"')
         ))),
+    }
+}
+
+/// A file name from a scene file's bytes (an `mtllib` or texture statement, a glTF URI): as they
+/// are on Unix, where names are bytes; elsewhere as text, bytes that are not UTF-8 read as Latin-1
+/// (as OBJ text is).
+pub(crate) fn path_from_bytes(bytes: Vec<u8>) -> PathBuf {
+    #[cfg(unix)]
+    {
+        use std::os::unix::ffi::OsStringExt;
+        PathBuf::from(std::ffi::OsString::from_vec(bytes))
+    }
+    #[cfg(not(unix))]
+    {
+        let text = String::from_utf8(bytes).unwrap_or_else(|e| e.into_bytes().iter().map(|&b| char::from(b)).collect());
+        PathBuf::from(text)
     }
 }

@@ -23,6 +23,7 @@ use crate::error::{Error, Result, shown_bytes, shown_path};
 use crate::materials::Material;
 use crate::scene::Scene;
 use crate::scene::load::memory::{Memory, MeshSize, check_mesh_memory};
+use crate::scene::load::path_from_bytes;
 use crate::scene::load::polygon;
 use crate::scene::mesh::{NO_INDEX, TriangleMesh};
 use crate::util::read;
@@ -32,7 +33,7 @@ use rayon::prelude::*;
 use skipped::SkippedStatements;
 use std::io;
 use std::path::{Path, PathBuf};
-use text::{path_from_bytes, text};
+use text::text;
 
 /// Chunk size for parallel parsing: large enough that per-chunk overhead is noise, small enough
 /// that a 45 MB file gives dozens of chunks to balance across cores.

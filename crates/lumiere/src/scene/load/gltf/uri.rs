@@ -1,6 +1,7 @@
 //! The URIs a glTF file names its buffers and images by: `data:` URIs carry their bytes in base64;
 //! any other URI without a scheme is a path relative to the glTF file, percent-encoded.
 
+use crate::scene::load::path_from_bytes;
 use base64::Engine;
 use std::path::{Path, PathBuf};
 
@@ -38,7 +39,7 @@ pub(super) fn resolve(uri: &str, file: &Path) -> Result<Uri, String> {
         return Err("an empty URI".to_string());
     }
     let folder = file.parent().unwrap_or(Path::new(""));
-    Ok(Uri::File(folder.join(path_of(relative))))
+    Ok(Uri::File(folder.join(path_from_bytes(relative))))
 }
 
 /// RFC 3986's scheme: a letter, then letters, digits, `+`, `-` or `.`. A single letter is read as
@@ -69,17 +70,6 @@ fn percent_decoded(uri: &str) -> Result<Vec<u8>, String> {
         i += 3;
     }
     Ok(decoded)
-}
-
-#[cfg(unix)]
-fn path_of(bytes: Vec<u8>) -> PathBuf {
-    use std::os::unix::ffi::OsStringExt;
-    PathBuf::from(std::ffi::OsString::from_vec(bytes))
-}
-
-#[cfg(not(unix))]
-fn path_of(bytes: Vec<u8>) -> PathBuf {
-    PathBuf::from(String::from_utf8_lossy(&bytes).into_owned())
 }
 
 #[cfg(test)]

@@ -2,10 +2,11 @@
 //! because a render with one wrong material is more useful than no render.
 
 use super::continued::{has_continuations, joined};
-use super::text::{LONE_CARRIAGE_RETURNS, Tokens, finite_f32, has_lone_carriage_returns, lines, path_from_bytes};
+use super::text::{LONE_CARRIAGE_RETURNS, Tokens, finite_f32, has_lone_carriage_returns, lines};
 use crate::error::{quote, shown_path};
 use crate::materials::{Material, MaterialKind};
 use crate::math::UvTransform;
+use crate::scene::load::path_from_bytes;
 use crate::scene::load::warnings::Warnings;
 use glam::Vec3;
 use std::path::{Path, PathBuf};

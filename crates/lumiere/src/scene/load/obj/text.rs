@@ -6,7 +6,6 @@
 
 use crate::error::quote;
 use std::borrow::Cow;
-use std::path::PathBuf;
 
 /// The lines of `bytes`, split at `\n`. A CRLF line keeps its `\r`, which the tokenizer treats as
 /// whitespace. There is always exactly one more piece than there are `\n` bytes.
@@ -128,18 +127,4 @@ pub(super) fn saturating_i64(token: &[u8]) -> Option<i64> {
         value = value.saturating_mul(10).saturating_add(i64::from(digit - b'0'));
     }
     Some(if negative { -value } else { value })
-}
-
-/// A file name from a file's bytes: as they are on Unix, where names are bytes; elsewhere as
-/// text (see [`text`]).
-pub(super) fn path_from_bytes(bytes: Vec<u8>) -> PathBuf {
-    #[cfg(unix)]
-    {
-        use std::os::unix::ffi::OsStringExt;
-        PathBuf::from(std::ffi::OsString::from_vec(bytes))
-    }
-    #[cfg(not(unix))]
-    {
-        PathBuf::from(text(&bytes).into_owned())
-    }
 }
