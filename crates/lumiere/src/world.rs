@@ -10,12 +10,12 @@ use crate::accel::{Accel, BuildPreset, Hit, Isa, OriginBatch, Region};
 use crate::geometry::surface::SurfacePoint;
 use crate::geometry::surface_lanes::{HitCorners, SurfaceRows};
 use crate::lights::LightSet;
-use crate::materials::{Material, MaterialBsdf, MaterialKind};
+use crate::materials::{CoverageTest, Material, MaterialBsdf, MaterialKind};
 use crate::math::rows::{Rows, set_row};
 use crate::math::{Ray, UvTransform};
 use crate::scene::Scene;
 use crate::scene::mesh::NO_INDEX;
-use crate::textures::{TextureId, TextureSet};
+use crate::textures::{Texture, TextureId, TextureSet};
 use crate::util::memory::prefetch;
 
 pub struct World {
@@ -30,11 +30,13 @@ pub struct World {
     texture_of_material: Vec<Option<(TextureId, Option<UvTransform>)>>,
     textures: TextureSet,
     /// Each material's coverage texture (`map_d`), decoded once: rays pass through its surface
-    /// where the coverage is below one half ([`World::opaque_at`]).
+    /// where the coverage fails the material's test ([`World::opaque_at`]).
     cutout_of_material: Vec<Option<(TextureId, Option<UvTransform>)>>,
-    /// The coverage textures that decoded; without one (most scenes) every query goes straight
-    /// to the BVH, its packets and batches (see [`World::has_cutouts`]).
+    /// The coverage textures that decoded.
     cutouts: TextureSet,
+    /// Whether a coverage texture may cut a surface out; without one (most scenes) every query
+    /// goes straight to the BVH, its packets and batches (see [`World::has_cutouts`]).
+    cuts: bool,
     /// What could not be derived (textures that failed to load), for the user to see.
     warnings: Vec<String>,
     /// The diagonal of the scene's bounding box: no two of its points lie farther apart.
@@ -93,6 +95,11 @@ impl World {
         let (cutout_of_material, cutouts, cutout_warnings) =
             TextureSet::for_cutouts(scene.materials.iter().map(Material::cutout_mask), &scene.embedded_images);
         warnings.extend(cutout_warnings);
+        let cuts = scene
+            .materials
+            .iter()
+            .zip(&cutout_of_material)
+            .any(|(material, cutout)| cutout.is_some_and(|id| may_cut(material.map_d_test, cutouts.get(id))));
         let cutout_of_material = placed(cutout_of_material, scene.materials.iter().map(|m| m.map_d_transform));
         let diameter = scene.bounds().extent().length();
         let prefetches = scene.mesh.memory_bytes() + textures.memory_bytes() > PREFETCH_ABOVE_BYTES;
@@ -105,6 +112,7 @@ impl World {
             textures,
             cutout_of_material,
             cutouts,
+            cuts,
             warnings,
             diameter,
             hard_shadow_batches: OnceLock::new(),
@@ -275,11 +283,11 @@ impl World {
         self.accel.occluded(ray)
     }
 
-    /// Whether a material has a coverage texture that decoded: then each ray is traced alone, and
-    /// each hit on a cutout material is tested against its texture.
+    /// Whether a material has a coverage texture that may cut its surface out: then each ray is
+    /// traced alone, and each hit on a cutout material is tested against its texture.
     #[inline]
     fn has_cutouts(&self) -> bool {
-        !self.cutouts.is_empty()
+        self.cuts
     }
 
     /// Bit `lane` set for each `live` lane whose ray `ray(lane)` is blocked, traced one by one.
@@ -288,13 +296,14 @@ impl World {
     }
 
     /// Whether triangle `id` is there at barycentrics `(u, v)` of its second and third corners:
-    /// false where its material's coverage texture (`map_d`) is below one half, the alpha test of
-    /// cutout leaves and fences.
+    /// false where its material's coverage texture (`map_d`) fails the material's test (below one
+    /// half, for MTL), the alpha test of cutout leaves and fences.
     fn opaque_at(&self, id: u32, u: f32, v: f32) -> bool {
         let material = self.scene.mesh.material_ids[id as usize] as usize;
         let Some((texture, placement)) = self.cutout_of_material[material] else { return true };
-        let uv = self.interpolated_texcoord(id as usize, 1.0 - u - v, u, v);
-        self.cutouts.get(texture).sample_coverage(placed_uv(placement, uv)) >= 0.5
+        let uv = placed_uv(placement, self.interpolated_texcoord(id as usize, 1.0 - u - v, u, v));
+        let (texture, test) = (self.cutouts.get(texture), self.scene.materials[material].map_d_test);
+        test.keeps(if test.alpha_only { texture.sample_alpha(uv) } else { texture.sample_coverage(uv) })
     }
 
     /// Readies `batch` for `rays` rays leaving `origin` inside `region`: gathers their candidate
@@ -425,6 +434,13 @@ impl World {
     fn interpolated_texcoord(&self, id: usize, w: f32, u: f32, v: f32) -> Vec2 {
         self.scene.mesh.corner_texcoords(id).map_or(Vec2::ZERO, |[a, b, c]| w * a + u * b + v * c)
     }
+}
+
+/// Whether `texture` read by `test` may cut a surface out: not where only alpha counts, the file
+/// has none, and full coverage passes (a glTF `MASK` material with a JPEG base colour), which
+/// would give up the BVH's fast paths for nothing.
+fn may_cut(test: CoverageTest, texture: &Texture) -> bool {
+    !(test.alpha_only && !texture.has_alpha() && test.keeps(1.0))
 }
 
 /// Each material's texture id with that material's placement of it, where it moves the texture.

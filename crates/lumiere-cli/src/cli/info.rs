@@ -8,7 +8,7 @@ use glam::Vec3;
 
 use lumiere::Result;
 use lumiere::lights::LightSet;
-use lumiere::materials::{Material, MaterialKind};
+use lumiere::materials::{CoverageTest, Material, MaterialKind};
 use lumiere::math::UvTransform;
 use lumiere::scene::Scene;
 use lumiere::textures::TextureSet;
@@ -95,7 +95,13 @@ fn describe(material: &Material) -> String {
         }
     }
     if let Some(mask) = material.cutout_mask() {
-        parts.push(format!("map_d {}{:?} (cutout)", placement(material.map_d_transform), mask.display().to_string()));
+        let test = material.map_d_test;
+        let cut = if test == CoverageTest::MTL {
+            "cutout".to_string()
+        } else {
+            format!("cutout where its alpha x {} is below {}", number(test.scale), number(test.threshold))
+        };
+        parts.push(format!("map_d {}{:?} ({cut})", placement(material.map_d_transform), mask.display().to_string()));
     }
     if material.is_emissive() {
         parts.push(format!("Ke {} (a light)", vector(material.ke)));

@@ -315,11 +315,14 @@ fn a_ply_scene_renders_as_its_obj_twin() {
 #[test]
 fn a_glb_scene_renders_as_its_obj_twin() {
     let dir = TempDir::new("gltf-twin");
-    // The texture: any PNG; lumiere's own render of the box serves.
-    let texture = dir.path("tex.png");
-    let made = lumiere(&["render", "--mode", "hits", "--size", "4x4", "-o", texture.to_str().unwrap()]);
-    assert!(made.status.success(), "{}", stderr(&made));
-    let png = fs::read(&texture).unwrap();
+    // The texture: colours, and an alpha that cuts holes (MTL's `map_d`, glTF's `alphaMode MASK`)
+    // on both sides of one half.
+    let texels: Vec<u8> =
+        (0..16u8).flat_map(|i| [i * 16, 255 - i * 8, 60 + i, [0, 255, 127, 128][i as usize % 4]]).collect();
+    let mut png = std::io::Cursor::new(Vec::new());
+    image::RgbaImage::from_raw(4, 4, texels).unwrap().write_to(&mut png, image::ImageFormat::Png).unwrap();
+    let png = png.into_inner();
+    dir.write("tex.png", &png);
     let corners = [
         [-1.0f32, 0.0, -1.0],
         [1.0, 0.0, -1.0],
@@ -342,7 +345,7 @@ fn a_glb_scene_renders_as_its_obj_twin() {
     dir.write("twin.obj", obj);
     dir.write(
         "twin.mtl",
-        "newmtl floor\nKd 1 1 1\nPm 0\nPr 0.5\nmap_Kd tex.png\nnewmtl lamp\nKd 0 0 0\nKe 5 5 5\nPm 0\nPr 1\n",
+        "newmtl floor\nKd 1 1 1\nPm 0\nPr 0.5\nmap_Kd tex.png\nmap_d tex.png\nnewmtl lamp\nKd 0 0 0\nKe 5 5 5\nPm 0\nPr 1\n",
     );
     let mut bin: Vec<u8> = corners.iter().flatten().flat_map(|c| c.to_le_bytes()).collect();
     bin.extend(uv.iter().flat_map(|[u, v]| [*u, 1.0 - v]).flat_map(|c| c.to_le_bytes()));
@@ -359,7 +362,7 @@ fn a_glb_scene_renders_as_its_obj_twin() {
             {{"attributes": {{"POSITION": 0, "TEXCOORD_0": 1}}, "indices": 2, "material": 0}},
             {{"attributes": {{"POSITION": 3}}, "indices": 4, "material": 1}}]}}],
         "materials": [
-            {{"name": "floor", "pbrMetallicRoughness": {{"metallicFactor": 0, "roughnessFactor": 0.5, "baseColorTexture": {{"index": 0}}}}}},
+            {{"name": "floor", "alphaMode": "MASK", "pbrMetallicRoughness": {{"metallicFactor": 0, "roughnessFactor": 0.5, "baseColorTexture": {{"index": 0}}}}}},
             {{"name": "lamp", "pbrMetallicRoughness": {{"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0}}, "emissiveFactor": [1, 1, 1],
               "extensions": {{"KHR_materials_emissive_strength": {{"emissiveStrength": 5}}}}}}],
         "extensionsUsed": ["KHR_materials_emissive_strength"],

@@ -46,11 +46,14 @@ pub struct Material {
     pub map_kd: Option<PathBuf>,
     /// Where `map_kd` lies on the surface (its `-s` and `-o` options).
     pub map_kd_transform: UvTransform,
-    /// Coverage texture (MTL `map_d`), resolved relative to the MTL file: where its coverage is
-    /// below one half the surface is cut out (rays pass through it), as leaves and fences are drawn.
+    /// Coverage texture (MTL `map_d`), resolved relative to the MTL file: where its coverage fails
+    /// `map_d_test` (below one half, for MTL) the surface is cut out (rays pass through it), as
+    /// leaves and fences are drawn.
     pub map_d: Option<PathBuf>,
     /// Where `map_d` lies on the surface (its `-s` and `-o` options).
     pub map_d_transform: UvTransform,
+    /// How `map_d`'s coverage is read and where it cuts: MTL's rule, or glTF's `alphaMode MASK`.
+    pub map_d_test: CoverageTest,
     /// Index of refraction (MTL `Ni`) of a transmissive material.
     pub ni: f32,
     /// Opacity (`d`, or `1 − Tr`), 1 = opaque. Below 1 together with an explicit `Ni`, the surface
@@ -67,6 +70,32 @@ pub struct Material {
     /// Perceptual roughness (MTL PBR extension `Pr`, 0–1); GGX `α = Pr²`. `None` when the file
     /// does not say.
     pub roughness: Option<f32>,
+}
+
+/// Where a coverage texture keeps its surface: where `coverage × scale ≥ threshold`, the coverage
+/// being the texture's bilinearly filtered alpha, or (unless `alpha_only`) the grey level of a file
+/// without alpha.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CoverageTest {
+    /// Whether only the alpha channel counts, a file without one being opaque (glTF, where the
+    /// texture is the base colour's); otherwise a file without alpha is read as a grey mask, as
+    /// renderers read MTL's `map_d`.
+    pub alpha_only: bool,
+    /// What the coverage is multiplied by: glTF's `baseColorFactor` alpha; 1 for MTL.
+    pub scale: f32,
+    /// The coverage from which the surface is there: glTF's `alphaCutoff`; one half for MTL.
+    pub threshold: f32,
+}
+
+impl CoverageTest {
+    /// MTL's `map_d`: alpha, or grey levels without it, cut below one half.
+    pub const MTL: CoverageTest = CoverageTest { alpha_only: false, scale: 1.0, threshold: 0.5 };
+
+    /// Whether a surface of coverage `coverage` is there.
+    #[inline]
+    pub fn keeps(&self, coverage: f32) -> bool {
+        coverage * self.scale >= self.threshold
+    }
 }
 
 /// The kind of scattering a [`Material`] stands for, with its parameters resolved from the file's
@@ -138,6 +167,7 @@ impl Material {
             map_kd_transform: UvTransform::default(),
             map_d: None,
             map_d_transform: UvTransform::default(),
+            map_d_test: CoverageTest::MTL,
             ni: 1.0,
             dissolve: 1.0,
             illum: 1,

@@ -6,7 +6,8 @@
 use crate::common::TempDir;
 use base64::Engine;
 use glam::{Vec2, Vec3};
-use lumiere::materials::MaterialKind;
+use lumiere::materials::{CoverageTest, MaterialKind};
+use lumiere::math::Ray;
 use lumiere::scene::Scene;
 use lumiere::scene::load::gltf::{DEFAULT_NAME, parse_gltf, parse_gltf_with_memory};
 use lumiere::scene::load::load;
@@ -348,7 +349,11 @@ fn a_long_string_of_the_wrong_type_gives_a_short_error() {
 
 /// A 2×1 PNG: a red texel and a blue one.
 fn png() -> Vec<u8> {
-    let image = image::RgbImage::from_raw(2, 1, vec![255, 0, 0, 0, 0, 255]).unwrap();
+    encoded(image::RgbImage::from_raw(2, 1, vec![255, 0, 0, 0, 0, 255]).unwrap().into())
+}
+
+/// The bytes of a PNG file of `image`.
+fn encoded(image: image::DynamicImage) -> Vec<u8> {
     let mut bytes = io::Cursor::new(Vec::new());
     image.write_to(&mut bytes, image::ImageFormat::Png).unwrap();
     bytes.into_inner()
@@ -382,6 +387,87 @@ fn materials_map_onto_lumieres_kinds() {
     assert_eq!(scene.materials[3].ke, Vec3::new(8., 4., 2.));
     assert_eq!(scene.mesh.material_ids, [0, 0, 1, 1, 2, 2, 3, 3]);
     assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+}
+
+/// A 2×1 PNG with alpha: a left texel of alpha 0.2, a right one of alpha 0.8.
+fn png_with_alpha() -> Vec<u8> {
+    encoded(image::RgbaImage::from_raw(2, 1, vec![255, 255, 255, 51, 255, 255, 255, 204]).unwrap().into())
+}
+
+#[test]
+fn alpha_mask_materials_cut_their_surface_where_the_base_colour_alpha_is_below_the_cutoff() {
+    let mut builder = Builder::default();
+    let primitive = quad(&mut builder);
+    let with_alpha = builder.view(&png_with_alpha(), None);
+    let without_alpha = builder.view(&png(), None);
+    // Each material on a quad of its own, the i-th at x = 2i; the texture's left texel (alpha 0.2)
+    // covers x < 0.5 of the quad, its right one (alpha 0.8) the rest.
+    let materials = [
+        r#"{"name": "leaf", "alphaMode": "MASK", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}"#,
+        r#"{"alphaMode": "MASK", "alphaCutoff": 0.05, "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "baseColorFactor": [1, 1, 1, 0.5]}}"#,
+        r#"{"alphaMode": "MASK", "alphaCutoff": 0.9, "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}"#,
+        r#"{"alphaCutoff": 0.9, "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}"#,
+        r#"{"alphaMode": "MASK", "pbrMetallicRoughness": {"baseColorTexture": {"index": 1}}}"#,
+        r#"{"alphaMode": "MASK", "pbrMetallicRoughness": {"baseColorTexture": {"index": 1}, "baseColorFactor": [1, 1, 1, 0.4]}}"#,
+        r#"{"name": "hidden", "alphaMode": "MASK", "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 0.4]}}"#,
+        r#"{"alphaMode": "MASK", "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 0.6]}}"#,
+    ];
+    // Whether each quad is there at its left and right halves, or not drawn at all.
+    let expected = [
+        Some([false, true]), // alpha below the default cutoff of one half on the left
+        Some([true, true]),  // 0.2 × 0.5 and 0.8 × 0.5 both reach 0.05
+        Some([false, false]),
+        Some([true, true]),   // OPAQUE: alpha is ignored
+        Some([true, true]),   // no alpha channel: opaque
+        Some([false, false]), // ... times 0.4, below one half
+        None,                 // no texture, alpha below the cutoff: cut whole
+        Some([true, true]),
+    ];
+    let meshes: Vec<String> = (0..materials.len())
+        .map(|m| {
+            let primitive = primitive.replace(r#""indices""#, &format!(r#""material": {m}, "indices""#));
+            format!(r#"{{"primitives": [{primitive}]}}"#)
+        })
+        .collect();
+    let nodes: Vec<String> =
+        (0..materials.len()).map(|m| format!(r#"{{"mesh": {m}, "translation": [{}, 0, 0]}}"#, 2 * m)).collect();
+    let roots: Vec<String> = (0..materials.len()).map(|m| m.to_string()).collect();
+    let rest = format!(
+        r#""meshes": [{}], "nodes": [{}], "scenes": [{{"nodes": [{}]}}], "materials": [{}],
+        "images": [{{"bufferView": {with_alpha}, "mimeType": "image/png"}}, {{"bufferView": {without_alpha}, "mimeType": "image/png"}}],
+        "textures": [{{"source": 0}}, {{"source": 1}}]"#,
+        meshes.join(", "),
+        nodes.join(", "),
+        roots.join(", "),
+        materials.join(", ")
+    );
+    let scene = parse(&builder.gltf(&rest));
+    let leaf = &scene.materials[0];
+    assert_eq!(leaf.map_d, leaf.map_kd, "the cutout reads the base colour texture");
+    assert_eq!(leaf.map_d_test, CoverageTest { alpha_only: true, scale: 1.0, threshold: 0.5 });
+    assert_eq!(scene.materials[1].map_d_test, CoverageTest { alpha_only: true, scale: 0.5, threshold: 0.05 });
+    assert_eq!(scene.materials[3].map_d, None, "an OPAQUE material is not cut");
+    assert_eq!(scene.materials[7].map_d, None);
+    assert_eq!(
+        scene.warnings,
+        ["test.gltf: material 'hidden': alphaMode MASK cuts the whole surface out (baseColorFactor alpha 0.4 \
+             below alphaCutoff 0.5, no texture); its primitives are not drawn"]
+    );
+    let drawn: Vec<u32> = expected.iter().enumerate().filter(|(_, e)| e.is_some()).map(|(m, _)| m as u32).collect();
+    let mut materials_drawn = scene.mesh.material_ids.clone();
+    materials_drawn.dedup();
+    assert_eq!(materials_drawn, drawn);
+    let world = lumiere::world::World::new(scene, lumiere::accel::BuildPreset::Default);
+    assert!(world.warnings().is_empty(), "{:?}", world.warnings());
+    for (m, expected) in expected.iter().enumerate() {
+        let there = [0.25, 0.75].map(|x| {
+            let ray = Ray::new(Vec3::new(2.0 * m as f32 + x, 0.5, 1.0), -Vec3::Z);
+            let hit = world.intersect(&ray);
+            assert_eq!(hit.is_some(), world.occluded(&ray), "material {m}: occlusion as intersection");
+            hit.is_some()
+        });
+        assert_eq!(there, expected.unwrap_or([false, false]), "material {m}");
+    }
 }
 
 #[test]

@@ -6,8 +6,9 @@
 //! coordinates its material's base colour texture reads (`TEXCOORD_n`, `v` flipped to OBJ's
 //! bottom-up convention), indexed or not, quantised (`KHR_mesh_quantization`) or sparse
 //! (`accessor.rs`); the metallic-roughness materials with their base colour textures, glass from
-//! `KHR_materials_transmission`, and emission (`materials.rs`). A node whose transform mirrors
-//! (negative determinant) has its triangles' corners swapped, so that a face keeps its front.
+//! `KHR_materials_transmission`, emission, and `alphaMode MASK` as cutouts (`materials.rs`). A
+//! node whose transform mirrors (negative determinant) has its triangles' corners swapped, so that
+//! a face keeps its front.
 //! Anything else (points and lines, cameras, skins, animations, morph targets, unsupported
 //! extensions and material properties) is named in a warning, never silently dropped; a file that
 //! *requires* an extension lumiere does not read is refused.
@@ -73,37 +74,35 @@ fn parse_within(bytes: &[u8], file: &Path, read: ReadFile, memory: Memory) -> Re
     let mut image_path = |image: &gltf::Image| image_source(image, &buffers.data, file, &mut embedded);
     // Every material the file defines is kept, drawn or not, at its index in the file, so that
     // `--emission NAME` finds any of them.
-    let (mut materials, mut texcoord_sets): (Vec<Material>, Vec<u32>) = document
-        .materials()
-        .map(|m| materials::convert(&m, file, &mut image_path, &mut warnings))
-        .map(|converted| (converted.material, converted.texcoord_set))
-        .unzip();
+    let mut converted: Vec<materials::Converted> =
+        document.materials().map(|m| materials::convert(&m, file, &mut image_path, &mut warnings)).collect();
     // glTF's default material, for primitives that name none, only where one is drawn.
-    let default_id = materials.len();
+    let default_id = converted.len();
     let drawn = instances.iter().flat_map(|instance| meshes[instance.mesh].primitives());
     if drawn.filter(|p| is_triangles(p.mode())).any(|p| p.material().index().is_none()) {
-        let default = materials::default_material();
-        materials.push(default.material);
-        texcoord_sets.push(default.texcoord_set);
+        converted.push(materials::default_material());
     }
+    let texcoord_sets: Vec<u32> = converted.iter().map(|c| c.texcoord_set).collect();
+    let primitives = Drawn { sets: texcoord_sets, drawn: converted.iter().map(|c| c.drawn).collect(), default_id };
+    let materials: Vec<Material> = converted.into_iter().map(|c| c.material).collect();
 
-    let size = counted(&meshes, &instances, &texcoord_sets, file, &mut warnings)?;
+    let size = counted(&meshes, &instances, &primitives, file, &mut warnings)?;
     let held = buffers.data.iter().map(|data| data.len() as u64).sum();
     check_mesh_memory(file, size, held, memory, "mesh and BVH, beside the file's buffers")?;
 
     let mut mesh = TriangleMesh::default();
     let mut decoded: Vec<Option<Rc<Vec<Primitive>>>> = vec![None; meshes.len()];
     for instance in &instances {
-        let primitives = match &decoded[instance.mesh] {
+        let mesh_primitives = match &decoded[instance.mesh] {
             Some(primitives) => Rc::clone(primitives),
             None => {
                 let source = &meshes[instance.mesh];
-                let primitives = Rc::new(decode_mesh(source, &buffers.data, &texcoord_sets, default_id, file)?);
-                decoded[instance.mesh] = Some(Rc::clone(&primitives));
-                primitives
+                let decoded_mesh = Rc::new(decode_mesh(source, &buffers.data, &primitives, file)?);
+                decoded[instance.mesh] = Some(Rc::clone(&decoded_mesh));
+                decoded_mesh
             }
         };
-        for primitive in primitives.iter() {
+        for primitive in mesh_primitives.iter() {
             append(&mut mesh, primitive, instance, size, file)?;
         }
     }
@@ -141,7 +140,7 @@ fn image_source(
 fn counted(
     meshes: &[gltf::Mesh],
     instances: &[Instance],
-    texcoord_sets: &[u32],
+    primitives: &Drawn,
     file: &Path,
     warnings: &mut Warnings,
 ) -> Result<MeshSize> {
@@ -160,11 +159,14 @@ fn counted(
                 });
                 continue;
             }
+            if !primitives.draws(&primitive) {
+                continue;
+            }
             let Some(position) = primitive.get(&Semantic::Positions) else {
                 return Err(Error::invalid(format!("{}: no POSITION attribute", where_())));
             };
             let vertices = position.count() as u64;
-            let set = primitive.material().index().map_or(0, |material| texcoord_sets[material]);
+            let set = primitives.sets[primitives.material(&primitive)];
             for (semantic, total) in [(Semantic::Normals, &mut normals), (Semantic::TexCoords(set), &mut texcoords)] {
                 if let Some(attribute) = primitive.get(&semantic) {
                     if attribute.count() != position.count() {
@@ -203,6 +205,28 @@ fn is_triangles(mode: Mode) -> bool {
     matches!(mode, Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan)
 }
 
+/// Which primitives are drawn, with what: by their material's index (glTF's default material's
+/// for those that name none).
+struct Drawn {
+    /// The texture coordinate set (`TEXCOORD_n`) each material's texture reads.
+    sets: Vec<u32>,
+    /// Whether each material's surface is there at all (see `materials::Converted::drawn`).
+    drawn: Vec<bool>,
+    default_id: usize,
+}
+
+impl Drawn {
+    /// The index of `primitive`'s material.
+    fn material(&self, primitive: &gltf::Primitive) -> usize {
+        primitive.material().index().unwrap_or(self.default_id)
+    }
+
+    /// Whether `primitive` is drawn: triangles of a material that is there.
+    fn draws(&self, primitive: &gltf::Primitive) -> bool {
+        is_triangles(primitive.mode()) && self.drawn[self.material(primitive)]
+    }
+}
+
 /// The triangles `corners` vertices make in `mode`.
 fn triangle_count(mode: Mode, corners: u64) -> u64 {
     match mode {
@@ -220,15 +244,9 @@ struct Primitive {
     material: u32,
 }
 
-fn decode_mesh(
-    mesh: &gltf::Mesh,
-    buffers: BufferData,
-    texcoord_sets: &[u32],
-    default_id: usize,
-    file: &Path,
-) -> Result<Vec<Primitive>> {
+fn decode_mesh(mesh: &gltf::Mesh, buffers: BufferData, drawn: &Drawn, file: &Path) -> Result<Vec<Primitive>> {
     let mut primitives = Vec::new();
-    for primitive in mesh.primitives().filter(|p| is_triangles(p.mode())) {
+    for primitive in mesh.primitives().filter(|p| drawn.draws(p)) {
         let fail = |what: String, accessor: &gltf::Accessor, reason: String| {
             Error::invalid(format!(
                 "{}: mesh {} primitive {}: {what} (accessor {}): {reason}",
@@ -256,8 +274,8 @@ fn decode_mesh(
         let normals = read_attribute(Semantic::Normals, Dimensions::Vec3)?.map(|normals| {
             normals.into_iter().map(Vec3::from).map(|n| if n.is_finite() { n } else { Vec3::ZERO }).collect()
         });
-        let material = primitive.material().index().unwrap_or(default_id);
-        let set = texcoord_sets[material];
+        let material = drawn.material(&primitive);
+        let set = drawn.sets[material];
         let texcoords = match primitive.get(&Semantic::TexCoords(set)) {
             Some(accessor) => {
                 let what = || format!("TEXCOORD_{set}");

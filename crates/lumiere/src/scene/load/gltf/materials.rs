@@ -2,11 +2,12 @@
 //! extension's mapping (a metal from `metallic ≥ 0.5`, otherwise a plastic with a 4% layer;
 //! GGX `α = roughness²`), `KHR_materials_transmission` onto smooth glass of `KHR_materials_ior`'s
 //! index, emission from `emissiveFactor` (times `KHR_materials_emissive_strength`), and the base
-//! colour texture with its placement. What is not honoured is named in one warning per material.
+//! colour texture with its placement, and `alphaMode MASK` as a cutout by the base colour's alpha.
+//! What is not honoured is named in one warning per material.
 //! docs/MATERIALS.md has the table.
 
 use crate::error::{shown_name, shown_path};
-use crate::materials::Material;
+use crate::materials::{CoverageTest, Material};
 use crate::math::UvTransform;
 use crate::scene::load::warnings::Warnings;
 use glam::{Vec2, Vec3};
@@ -23,18 +24,20 @@ const GLASS_FROM_TRANSMISSION: f32 = 0.5;
 /// Finds the file a glTF image is in (or names its embedded bytes); the error is a reason.
 pub(super) type ImagePath<'r> = &'r mut dyn FnMut(&gltf::Image) -> Result<PathBuf, String>;
 
-/// A glTF material as lumiere draws it, and the texture coordinate set (`TEXCOORD_n`) its base
-/// colour texture reads.
+/// A glTF material as lumiere draws it, the texture coordinate set (`TEXCOORD_n`) its base
+/// colour texture reads, and whether its surface is there at all.
 pub(super) struct Converted {
     pub(super) material: Material,
     pub(super) texcoord_set: u32,
+    /// False where `alphaMode MASK` cuts the whole surface out: its primitives are not drawn.
+    pub(super) drawn: bool,
 }
 
 /// glTF's default material, of primitives that name none: white, metallic and rough.
 pub(super) fn default_material() -> Converted {
     let mut material = Material::default_grey(DEFAULT_NAME);
     (material.kd, material.metallic, material.roughness) = (Vec3::ONE, Some(1.0), Some(1.0));
-    Converted { material, texcoord_set: 0 }
+    Converted { material, texcoord_set: 0, drawn: true }
 }
 
 /// Converts `source`, warning (about `file`) about what is not honoured; `index` names an unnamed
@@ -52,7 +55,7 @@ pub(super) fn convert(
     let mut material = Material::default_grey(&name);
     let mut not_read: Vec<String> = Vec::new();
     let pbr = source.pbr_metallic_roughness();
-    let [r, g, b, _] = pbr.base_color_factor();
+    let [r, g, b, alpha] = pbr.base_color_factor();
     material.kd = Vec3::new(r, g, b);
     material.metallic = Some(pbr.metallic_factor());
     material.roughness = Some(pbr.roughness_factor());
@@ -103,11 +106,25 @@ pub(super) fn convert(
         not_read
             .push("emissiveTexture (the material does not emit; --emission NAME=R,G,B makes it a light)".to_string());
     }
+    let mut drawn = true;
+    if source.alpha_mode() == gltf::material::AlphaMode::Mask {
+        let cutoff = source.alpha_cutoff().unwrap_or(DEFAULT_ALPHA_CUTOFF);
+        drawn = mask(&mut material, alpha, cutoff);
+        if !drawn {
+            warnings.push(file, "materials cut out whole", || {
+                format!(
+                    "{}: material {}: alphaMode MASK cuts the whole surface out (baseColorFactor alpha {alpha} \
+                     below alphaCutoff {cutoff}, no texture); its primitives are not drawn",
+                    shown_path(file),
+                    shown_name(&name)
+                )
+            });
+        }
+    }
     for (present, what) in [
         (pbr.metallic_roughness_texture().is_some(), "metallicRoughnessTexture"),
         (source.normal_texture().is_some(), "normalTexture"),
         (source.occlusion_texture().is_some(), "occlusionTexture"),
-        (source.alpha_mode() == gltf::material::AlphaMode::Mask, "alphaMode MASK (drawn opaque)"),
         (source.alpha_mode() == gltf::material::AlphaMode::Blend, "alphaMode BLEND (drawn opaque)"),
     ] {
         if present {
@@ -120,7 +137,27 @@ pub(super) fn convert(
             format!("{}: material {}: not read: {list}", shown_path(file), shown_name(&name))
         });
     }
-    Converted { material, texcoord_set }
+    Converted { material, texcoord_set, drawn }
+}
+
+/// glTF's `alphaCutoff` where a `MASK` material gives none.
+const DEFAULT_ALPHA_CUTOFF: f32 = 0.5;
+
+/// glTF's `alphaMode MASK` onto a cutout: the surface is there where the base colour's alpha, its
+/// texture's (read from the same texels as the colour) times its factor's `alpha`, reaches
+/// `cutoff`. Without a texture the factor decides for the whole surface: returns whether it is
+/// there.
+fn mask(material: &mut Material, alpha: f32, cutoff: f32) -> bool {
+    let test = CoverageTest { alpha_only: true, scale: alpha, threshold: cutoff };
+    match &material.map_kd {
+        Some(texture) => {
+            material.map_d = Some(texture.clone());
+            material.map_d_transform = material.map_kd_transform;
+            material.map_d_test = test;
+            true
+        }
+        None => test.keeps(1.0),
+    }
 }
 
 /// The base colour texture's file, placement and coordinate set; what is not honoured of it goes
