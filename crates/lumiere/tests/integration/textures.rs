@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use crate::common::TempDir;
 use glam::{Vec2, Vec3};
 use image::{ImageFormat, Rgb, RgbImage, Rgba, RgbaImage};
+use lumiere::materials::CoverageTest;
 use lumiere::render::fingerprint::scene_fingerprint;
 use lumiere::scene::Scene;
 use lumiere::textures::{EmbeddedImages, MAX_TEXELS, Texture, TextureSet, srgb_to_linear};
@@ -596,5 +597,35 @@ fn the_scene_fingerprint_holds_the_texture_placements() {
     ];
     for (i, a) in placed.iter().enumerate() {
         assert!(placed[i + 1..].iter().all(|b| a != b), "{placed:x?}");
+    }
+}
+
+/// How a mask cuts (glTF's `alphaMode MASK`: alpha alone, times a factor, against a cutoff) is
+/// part of the scene's fingerprint; MTL's rule adds nothing, so that the fingerprints of OBJ
+/// scenes with cutouts stay what they were.
+#[test]
+fn the_scene_fingerprint_holds_how_a_mask_cuts() {
+    let dir = TempDir::new("fingerprint-mask-tests");
+    test_image().save_with_format(dir.path("leaf.png"), ImageFormat::Png).unwrap();
+    dir.write("m.mtl", "newmtl leaf\nmap_Kd leaf.png\nmap_d leaf.png\n");
+    let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl leaf\nf 1/1 2/2 3/3\n";
+    let scene = dir.write("s.obj", obj);
+    let fingerprint = |test: Option<CoverageTest>| {
+        let mut scene = Scene::load(&scene).unwrap();
+        if let Some(test) = test {
+            scene.materials[0].map_d_test = test;
+        }
+        scene_fingerprint(&World::new(scene, Default::default()))
+    };
+    let plain = fingerprint(None);
+    assert_eq!(fingerprint(Some(CoverageTest::MTL)), plain);
+    let tests = [
+        plain,
+        fingerprint(Some(CoverageTest { alpha_only: true, ..CoverageTest::MTL })),
+        fingerprint(Some(CoverageTest { scale: 0.5, ..CoverageTest::MTL })),
+        fingerprint(Some(CoverageTest { threshold: 0.3, ..CoverageTest::MTL })),
+    ];
+    for (i, a) in tests.iter().enumerate() {
+        assert!(tests[i + 1..].iter().all(|b| a != b), "{tests:x?}");
     }
 }
