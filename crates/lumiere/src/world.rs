@@ -15,7 +15,8 @@ use crate::math::rows::{Rows, set_row};
 use crate::math::{Ray, UvTransform};
 use crate::scene::Scene;
 use crate::scene::mesh::NO_INDEX;
-use crate::textures::{Texture, TextureId, TextureSet};
+use crate::textures::{TextureId, TextureSet};
+use crate::util::hash::mix64;
 use crate::util::memory::prefetch;
 
 pub struct World {
@@ -29,13 +30,13 @@ pub struct World {
     /// moves the texture: most scenes have none, and a lookup then costs what it did without.
     texture_of_material: Vec<Option<(TextureId, Option<UvTransform>)>>,
     textures: TextureSet,
-    /// Each material's coverage texture (`map_d`), decoded once: rays pass through its surface
-    /// where the coverage fails the material's test ([`World::opaque_at`]).
-    cutout_of_material: Vec<Option<(TextureId, Option<UvTransform>)>>,
-    /// The coverage textures that decoded.
+    /// How each material's surface is cut out, if it is: rays pass through it where its coverage
+    /// fails the material's test ([`World::opaque_at`]).
+    cutout_of_material: Vec<Option<Cutout>>,
+    /// The coverage textures (`map_d`) that decoded, each once.
     cutouts: TextureSet,
-    /// Whether a coverage texture may cut a surface out; without one (most scenes) every query
-    /// goes straight to the BVH, its packets and batches (see [`World::has_cutouts`]).
+    /// Whether a material may be cut out; without one (most scenes) every query goes straight to
+    /// the BVH, its packets and batches (see [`World::has_cutouts`]).
     cuts: bool,
     /// What could not be derived (textures that failed to load), for the user to see.
     warnings: Vec<String>,
@@ -95,12 +96,14 @@ impl World {
         let (cutout_of_material, cutouts, cutout_warnings) =
             TextureSet::for_cutouts(scene.materials.iter().map(Material::cutout_mask), &scene.embedded_images);
         warnings.extend(cutout_warnings);
-        let cuts = scene
+        let textures_of_cutouts = placed(cutout_of_material, scene.materials.iter().map(|m| m.map_d_transform));
+        let cutout_of_material: Vec<Option<Cutout>> = scene
             .materials
             .iter()
-            .zip(&cutout_of_material)
-            .any(|(material, cutout)| cutout.is_some_and(|id| may_cut(material.map_d_test, cutouts.get(id))));
-        let cutout_of_material = placed(cutout_of_material, scene.materials.iter().map(|m| m.map_d_transform));
+            .zip(textures_of_cutouts)
+            .map(|(material, texture)| cutout(material, texture))
+            .collect();
+        let cuts = cutout_of_material.iter().flatten().any(|cutout| cutout.may_cut(&cutouts));
         let diameter = scene.bounds().extent().length();
         let prefetches = scene.mesh.memory_bytes() + textures.memory_bytes() > PREFETCH_ABOVE_BYTES;
         World {
@@ -156,8 +159,9 @@ impl World {
     /// The stable hashes of the files material `material`'s diffuse and coverage textures were
     /// decoded from, `None` where it has none or its file could not be used.
     pub fn texture_contents(&self, material: usize) -> [Option<u64>; 2] {
-        [(&self.texture_of_material, &self.textures), (&self.cutout_of_material, &self.cutouts)]
-            .map(|(of_material, set)| of_material[material].map(|(id, _)| set.contents_hash(id)))
+        let cutout = self.cutout_of_material[material].and_then(|cutout| cutout.texture);
+        [(self.texture_of_material[material], &self.textures), (cutout, &self.cutouts)]
+            .map(|(texture, set)| texture.map(|(id, _)| set.contents_hash(id)))
     }
 
     /// Problems met while deriving the world (a texture that could not be decoded).
@@ -300,10 +304,13 @@ impl World {
     /// half, for MTL), the alpha test of cutout leaves and fences.
     fn opaque_at(&self, id: u32, u: f32, v: f32) -> bool {
         let material = self.scene.mesh.material_ids[id as usize] as usize;
-        let Some((texture, placement)) = self.cutout_of_material[material] else { return true };
-        let uv = placed_uv(placement, self.interpolated_texcoord(id as usize, 1.0 - u - v, u, v));
-        let (texture, test) = (self.cutouts.get(texture), self.scene.materials[material].map_d_test);
-        test.keeps(if test.alpha_only { texture.sample_alpha(uv) } else { texture.sample_coverage(uv) })
+        let Some(Cutout { texture, test }) = self.cutout_of_material[material] else { return true };
+        let coverage = texture.map_or(1.0, |(texture, placement)| {
+            let uv = placed_uv(placement, self.interpolated_texcoord(id as usize, 1.0 - u - v, u, v));
+            let texture = self.cutouts.get(texture);
+            if test.alpha_only { texture.sample_alpha(uv) } else { texture.sample_coverage(uv) }
+        });
+        test.keeps(coverage, || hit_hash(id, u, v))
     }
 
     /// Readies `batch` for `rays` rays leaving `origin` inside `region`: gathers their candidate
@@ -436,11 +443,38 @@ impl World {
     }
 }
 
-/// Whether `texture` read by `test` may cut a surface out: not where only alpha counts, the file
-/// has none, and full coverage passes (a glTF `MASK` material with a JPEG base colour), which
-/// would give up the BVH's fast paths for nothing.
-fn may_cut(test: CoverageTest, texture: &Texture) -> bool {
-    !(test.alpha_only && !texture.has_alpha() && test.keeps(1.0))
+/// How a material's surface is cut out: by its coverage texture (with its placement), or without
+/// one by its test alone (a glTF material whose factor's alpha covers part of it).
+#[derive(Clone, Copy)]
+struct Cutout {
+    texture: Option<(TextureId, Option<UvTransform>)>,
+    test: CoverageTest,
+}
+
+impl Cutout {
+    /// Whether the cutout may cut its surface: not where only alpha counts, the file has none,
+    /// and full coverage passes (a glTF `MASK` material with a JPEG base colour), which would give
+    /// up the BVH's fast paths for nothing.
+    fn may_cut(&self, textures: &TextureSet) -> bool {
+        let opaque_texture = |(id, _): (TextureId, _)| self.test.alpha_only && !textures.get(id).has_alpha();
+        !(self.texture.is_none_or(opaque_texture) && self.test.keeps_full_coverage())
+    }
+}
+
+/// `material`'s cutout, given its coverage texture where one decoded: none for a material that is
+/// whole (an emitter always is: see [`Material::cutout_mask`]).
+fn cutout(material: &Material, texture: Option<(TextureId, Option<UvTransform>)>) -> Option<Cutout> {
+    let test = material.map_d_test;
+    let cut_without_texture = !material.is_emissive() && !test.keeps_full_coverage();
+    (texture.is_some() || cut_without_texture).then_some(Cutout { texture, test })
+}
+
+/// A number in [0, 1) for the hit at barycentrics `(u, v)` of triangle `id`, which a hashed
+/// coverage test ([`crate::materials::Cut::Hashed`]) compares with: the same hit always gets the
+/// same number, and hits apart get numbers as good as independent.
+fn hit_hash(id: u32, u: f32, v: f32) -> f32 {
+    let point = mix64(u64::from(u.to_bits()) | u64::from(v.to_bits()) << 32);
+    (mix64(point ^ u64::from(id)) >> 40) as f32 * (1.0 / (1u32 << 24) as f32)
 }
 
 /// Each material's texture id with that material's placement of it, where it moves the texture.

@@ -8,7 +8,7 @@ use glam::Vec3;
 
 use lumiere::Result;
 use lumiere::lights::LightSet;
-use lumiere::materials::{CoverageTest, Material, MaterialKind};
+use lumiere::materials::{CoverageTest, Cut, Material, MaterialKind};
 use lumiere::math::UvTransform;
 use lumiere::scene::Scene;
 use lumiere::textures::TextureSet;
@@ -94,19 +94,27 @@ fn describe(material: &Material) -> String {
             parts.push(format!("map_Kd {}{:?}", placement(material.map_kd_transform), texture.display().to_string()));
         }
     }
+    let test = material.map_d_test;
     if let Some(mask) = material.cutout_mask() {
-        let test = material.map_d_test;
-        let cut = if test == CoverageTest::MTL {
-            "cutout".to_string()
-        } else {
-            format!("cutout where its alpha x {} is below {}", number(test.scale), number(test.threshold))
-        };
+        let cut = if test == CoverageTest::MTL { "cutout".to_string() } else { cut(test, "its alpha") };
         parts.push(format!("map_d {}{:?} ({cut})", placement(material.map_d_transform), mask.display().to_string()));
+    } else if !test.keeps_full_coverage() && !material.is_emissive() {
+        parts.push(cut(test, "coverage"));
     }
     if material.is_emissive() {
         parts.push(format!("Ke {} (a light)", vector(material.ke)));
     }
     parts.join(", ")
+}
+
+/// How a coverage test other than MTL's cuts: `coverage` names what it reads.
+fn cut(test: CoverageTest, coverage: &str) -> String {
+    match test.cut {
+        Cut::Below(threshold) => {
+            format!("cut out where {coverage} x {} is below {}", number(test.scale), number(threshold))
+        }
+        Cut::Hashed => format!("covering {coverage} x {} of the surface, hashed", number(test.scale)),
+    }
 }
 
 /// A texture's `-s` and `-o` as the MTL writes them, where they move it.

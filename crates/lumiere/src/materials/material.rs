@@ -72,9 +72,9 @@ pub struct Material {
     pub roughness: Option<f32>,
 }
 
-/// Where a coverage texture keeps its surface: where `coverage × scale ≥ threshold`, the coverage
-/// being the texture's bilinearly filtered alpha, or (unless `alpha_only`) the grey level of a file
-/// without alpha.
+/// Where a coverage texture keeps its surface: the coverage (the texture's bilinearly filtered
+/// alpha, or unless `alpha_only` the grey level of a file without alpha; 1 without a texture)
+/// times `scale`, tested as `cut` says.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CoverageTest {
     /// Whether only the alpha channel counts, a file without one being opaque (glTF, where the
@@ -83,18 +83,43 @@ pub struct CoverageTest {
     pub alpha_only: bool,
     /// What the coverage is multiplied by: glTF's `baseColorFactor` alpha; 1 for MTL.
     pub scale: f32,
-    /// The coverage from which the surface is there: glTF's `alphaCutoff`; one half for MTL.
-    pub threshold: f32,
+    pub cut: Cut,
+}
+
+/// How a coverage cuts a surface out.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Cut {
+    /// Where the coverage is below this threshold: one half for MTL, `alphaCutoff` for glTF's
+    /// `MASK`.
+    Below(f32),
+    /// With a probability of one minus the coverage, decided at each point by a hash of the point
+    /// (hashed alpha testing, as pbrt-v4 reads an alpha below 1): a partly covering surface
+    /// (glTF's `BLEND`) lets that share of the rays that meet it through, and the same ray always
+    /// the same way.
+    Hashed,
 }
 
 impl CoverageTest {
     /// MTL's `map_d`: alpha, or grey levels without it, cut below one half.
-    pub const MTL: CoverageTest = CoverageTest { alpha_only: false, scale: 1.0, threshold: 0.5 };
+    pub const MTL: CoverageTest = CoverageTest { alpha_only: false, scale: 1.0, cut: Cut::Below(0.5) };
 
-    /// Whether a surface of coverage `coverage` is there.
+    /// Whether a surface of coverage `coverage` is there; `hash` gives the point's number in
+    /// [0, 1) that a [`Cut::Hashed`] compares the coverage with.
     #[inline]
-    pub fn keeps(&self, coverage: f32) -> bool {
-        coverage * self.scale >= self.threshold
+    pub fn keeps(&self, coverage: f32, hash: impl FnOnce() -> f32) -> bool {
+        let coverage = coverage * self.scale;
+        match self.cut {
+            Cut::Below(threshold) => coverage >= threshold,
+            Cut::Hashed => coverage > hash(),
+        }
+    }
+
+    /// Whether full coverage keeps the surface everywhere: then only a texture's alpha can cut it.
+    pub fn keeps_full_coverage(&self) -> bool {
+        match self.cut {
+            Cut::Below(threshold) => self.scale >= threshold,
+            Cut::Hashed => self.scale >= 1.0,
+        }
     }
 }
 

@@ -5,7 +5,7 @@
 
 use std::hash::Hasher;
 
-use crate::materials::CoverageTest;
+use crate::materials::{CoverageTest, Cut};
 use crate::render::checkpoint::{Checkpoint, differing_options};
 use crate::render::film::Film;
 use crate::render::{RenderOptions, RenderStats};
@@ -37,13 +37,17 @@ pub fn scene_fingerprint(world: &World) -> u64 {
         if let Some(map_d) = &m.map_d {
             h.write(b"map_d");
             h.write(map_d.as_os_str().as_encoded_bytes());
-            // And its test only where it is not MTL's, for the same reason.
-            let test = m.map_d_test;
-            if test != CoverageTest::MTL {
-                h.write(b"map_d test");
-                h.write_u8(u8::from(test.alpha_only));
-                h.write_f32s([test.scale, test.threshold]);
-            }
+        }
+        // The same for the coverage test: MTL's adds nothing.
+        let test = m.map_d_test;
+        if test != CoverageTest::MTL {
+            h.write(b"map_d test");
+            h.write_u8(u8::from(test.alpha_only));
+            let threshold = match test.cut {
+                Cut::Below(threshold) => threshold,
+                Cut::Hashed => f32::NAN,
+            };
+            h.write_f32s([test.scale, threshold]);
         }
         // The same for the textures' placements, hashed only where they move a texture.
         for (key, transform) in [(&b"map_kd -s -o"[..], m.map_kd_transform), (&b"map_d -s -o"[..], m.map_d_transform)] {

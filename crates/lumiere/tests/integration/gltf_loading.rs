@@ -6,7 +6,7 @@
 use crate::common::TempDir;
 use base64::Engine;
 use glam::{Vec2, Vec3};
-use lumiere::materials::{CoverageTest, MaterialKind};
+use lumiere::materials::{CoverageTest, Cut, MaterialKind};
 use lumiere::math::Ray;
 use lumiere::scene::Scene;
 use lumiere::scene::load::gltf::{DEFAULT_NAME, parse_gltf, parse_gltf_with_memory};
@@ -389,6 +389,27 @@ fn materials_map_onto_lumieres_kinds() {
     assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
 }
 
+/// The members of a file drawing `primitive` once per material of `materials`, the `m`-th at
+/// x = 2m, with `images` (more members: images, textures).
+fn quad_per_material(primitive: &str, materials: &[&str], images: &str) -> String {
+    let meshes: Vec<String> = (0..materials.len())
+        .map(|m| {
+            let primitive = primitive.replace(r#""indices""#, &format!(r#""material": {m}, "indices""#));
+            format!(r#"{{"primitives": [{primitive}]}}"#)
+        })
+        .collect();
+    let nodes: Vec<String> =
+        (0..materials.len()).map(|m| format!(r#"{{"mesh": {m}, "translation": [{}, 0, 0]}}"#, 2 * m)).collect();
+    let roots: Vec<String> = (0..materials.len()).map(|m| m.to_string()).collect();
+    format!(
+        r#""meshes": [{}], "nodes": [{}], "scenes": [{{"nodes": [{}]}}], "materials": [{}], {images}"#,
+        meshes.join(", "),
+        nodes.join(", "),
+        roots.join(", "),
+        materials.join(", ")
+    )
+}
+
 /// A 2×1 PNG with alpha: a left texel of alpha 0.2, a right one of alpha 0.8.
 fn png_with_alpha() -> Vec<u8> {
     encoded(image::RgbaImage::from_raw(2, 1, vec![255, 255, 255, 51, 255, 255, 255, 204]).unwrap().into())
@@ -423,35 +444,22 @@ fn alpha_mask_materials_cut_their_surface_where_the_base_colour_alpha_is_below_t
         None,                 // no texture, alpha below the cutoff: cut whole
         Some([true, true]),
     ];
-    let meshes: Vec<String> = (0..materials.len())
-        .map(|m| {
-            let primitive = primitive.replace(r#""indices""#, &format!(r#""material": {m}, "indices""#));
-            format!(r#"{{"primitives": [{primitive}]}}"#)
-        })
-        .collect();
-    let nodes: Vec<String> =
-        (0..materials.len()).map(|m| format!(r#"{{"mesh": {m}, "translation": [{}, 0, 0]}}"#, 2 * m)).collect();
-    let roots: Vec<String> = (0..materials.len()).map(|m| m.to_string()).collect();
-    let rest = format!(
-        r#""meshes": [{}], "nodes": [{}], "scenes": [{{"nodes": [{}]}}], "materials": [{}],
-        "images": [{{"bufferView": {with_alpha}, "mimeType": "image/png"}}, {{"bufferView": {without_alpha}, "mimeType": "image/png"}}],
-        "textures": [{{"source": 0}}, {{"source": 1}}]"#,
-        meshes.join(", "),
-        nodes.join(", "),
-        roots.join(", "),
-        materials.join(", ")
+    let images = format!(
+        r#""images": [{{"bufferView": {with_alpha}, "mimeType": "image/png"}}, {{"bufferView": {without_alpha}, "mimeType": "image/png"}}],
+        "textures": [{{"source": 0}}, {{"source": 1}}]"#
     );
+    let rest = quad_per_material(&primitive, &materials, &images);
     let scene = parse(&builder.gltf(&rest));
     let leaf = &scene.materials[0];
     assert_eq!(leaf.map_d, leaf.map_kd, "the cutout reads the base colour texture");
-    assert_eq!(leaf.map_d_test, CoverageTest { alpha_only: true, scale: 1.0, threshold: 0.5 });
-    assert_eq!(scene.materials[1].map_d_test, CoverageTest { alpha_only: true, scale: 0.5, threshold: 0.05 });
+    assert_eq!(leaf.map_d_test, CoverageTest { alpha_only: true, scale: 1.0, cut: Cut::Below(0.5) });
+    assert_eq!(scene.materials[1].map_d_test, CoverageTest { alpha_only: true, scale: 0.5, cut: Cut::Below(0.05) });
     assert_eq!(scene.materials[3].map_d, None, "an OPAQUE material is not cut");
     assert_eq!(scene.materials[7].map_d, None);
     assert_eq!(
         scene.warnings,
-        ["test.gltf: material 'hidden': alphaMode MASK cuts the whole surface out (baseColorFactor alpha 0.4 \
-             below alphaCutoff 0.5, no texture); its primitives are not drawn"]
+        ["test.gltf: material 'hidden': alphaMode MASK cuts it out (baseColorFactor alpha 0.4 below alphaCutoff \
+          0.5), without a texture: its primitives are not drawn"]
     );
     let drawn: Vec<u32> = expected.iter().enumerate().filter(|(_, e)| e.is_some()).map(|(m, _)| m as u32).collect();
     let mut materials_drawn = scene.mesh.material_ids.clone();
@@ -467,6 +475,75 @@ fn alpha_mask_materials_cut_their_surface_where_the_base_colour_alpha_is_below_t
             hit.is_some()
         });
         assert_eq!(there, expected.unwrap_or([false, false]), "material {m}");
+    }
+}
+
+/// The share of `rays` that `world` lets through.
+fn share_through(world: &lumiere::world::World, rays: impl Iterator<Item = Ray>) -> f64 {
+    let (mut through, mut count) = (0, 0);
+    for ray in rays {
+        let hit = world.intersect(&ray);
+        assert_eq!(hit.is_some(), world.occluded(&ray), "occlusion as intersection");
+        assert_eq!(world.intersect(&ray), hit, "the same ray, the same answer");
+        through += usize::from(hit.is_none());
+        count += 1;
+    }
+    through as f64 / count as f64
+}
+
+/// Rays straight down onto 64 × 64 points of `[x - 0.1, x + 0.1] × [0.05, 0.95]`, in the z = 0 plane.
+fn rays_down_around(x: f32) -> impl Iterator<Item = Ray> {
+    (0..64 * 64).map(move |i| {
+        let (x, y) = (x - 0.1 + 0.2 * (i % 64) as f32 / 64.0, 0.05 + 0.9 * (i / 64) as f32 / 64.0);
+        Ray::new(Vec3::new(x, y, 1.0), -Vec3::Z)
+    })
+}
+
+#[test]
+fn blend_materials_stop_the_share_of_rays_their_alpha_covers() {
+    let mut builder = Builder::default();
+    let primitive = quad(&mut builder);
+    let with_alpha = builder.view(&png_with_alpha(), None);
+    let materials = [
+        r#"{"name": "veil", "alphaMode": "BLEND", "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 0.3]}}"#,
+        r#"{"alphaMode": "BLEND", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "baseColorFactor": [1, 1, 1, 0.5]}}"#,
+        r#"{"name": "gone", "alphaMode": "BLEND", "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 0]}}"#,
+        r#"{"alphaMode": "BLEND"}"#,
+        r#"{"name": "lamp", "alphaMode": "BLEND", "emissiveFactor": [1, 1, 1], "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 0.3]}}"#,
+    ];
+    // The share of each quad that is there within 0.1 of x = 0.25 and of x = 0.75, the centres of
+    // the texture's texels of alpha 0.2 and 0.8: filtered, the alpha runs from a centre's value
+    // towards its neighbour's, by 0.6 a half texel, so it is 0.26 and 0.74 there on average.
+    let expected = [Some([0.3, 0.3]), Some([0.13, 0.37]), None, Some([1.0, 1.0]), Some([1.0, 1.0])];
+    let images = format!(
+        r#""images": [{{"bufferView": {with_alpha}, "mimeType": "image/png"}}], "textures": [{{"source": 0}}]"#
+    );
+    let rest = quad_per_material(&primitive, &materials, &images);
+    let scene = parse(&builder.gltf(&rest));
+    assert_eq!(scene.materials[0].map_d_test, CoverageTest { alpha_only: true, scale: 0.3, cut: Cut::Hashed });
+    assert_eq!(scene.materials[0].map_d, None);
+    assert_eq!(scene.materials[1].map_d, scene.materials[1].map_kd);
+    let mut warnings = scene.warnings.clone();
+    warnings.sort();
+    assert_eq!(
+        warnings,
+        [
+            "test.gltf: material 'gone': alphaMode BLEND covers none of it (baseColorFactor alpha 0), without a \
+             texture: its primitives are not drawn",
+            "test.gltf: material 'lamp': not read: alphaMode BLEND on an emitter (drawn opaque: a light is whole)"
+        ]
+    );
+    let mut materials_drawn = scene.mesh.material_ids.clone();
+    materials_drawn.dedup();
+    assert_eq!(materials_drawn, [0, 1, 3, 4]);
+    let world = lumiere::world::World::new(scene, lumiere::accel::BuildPreset::Default);
+    for (m, expected) in expected.iter().enumerate() {
+        let Some(covered) = expected else { continue };
+        for (half, covered) in covered.iter().enumerate() {
+            let through = share_through(&world, rays_down_around(2.0 * m as f32 + 0.25 + 0.5 * half as f32));
+            // 4096 rays: the share's standard deviation is at most 0.0078; allow five of them.
+            assert!((through - (1.0 - covered)).abs() < 0.04, "material {m}, half {half}: {through} through");
+        }
     }
 }
 
@@ -559,7 +636,7 @@ fn what_is_not_drawn_is_named_in_warnings() {
         r#""meshes": [{{"primitives": [{primitive}, {points}]}}], "nodes": [{{"mesh": 0}}, {{"camera": 0}}, {{"mesh": 0}}],
         "cameras": [{{"type": "perspective", "perspective": {{"yfov": 0.8, "znear": 0.1}}}}],
         "scenes": [{{"nodes": [0, 1, 2]}}, {{"name": "other", "nodes": []}}], "scene": 0,
-        "materials": [{{"name": "rough", "normalTexture": {{"index": 0}}, "alphaMode": "BLEND",
+        "materials": [{{"name": "rough", "normalTexture": {{"index": 0}},
             "emissiveFactor": [1, 1, 1], "emissiveTexture": {{"index": 0}}}}],
         "textures": [{{"source": 0}}], "images": [{{"uri": "n.png"}}],
         "extensionsUsed": ["KHR_materials_clearcoat", "KHR_lights_punctual"]"#
@@ -573,7 +650,7 @@ fn what_is_not_drawn_is_named_in_warnings() {
         "test.gltf: the file has 2 scenes; drawing scene 0",
         "test.gltf: not read: cameras (frame the view with --eye and --target)",
         "test.gltf: material 'rough': not read: emissiveTexture (the material does not emit; --emission NAME=R,G,B \
-         makes it a light), normalTexture, alphaMode BLEND (drawn opaque)",
+         makes it a light), normalTexture",
         "test.gltf: mesh 0 primitive 1: Points are not drawn (lumiere draws triangles)",
     ];
     let mut warnings = scene.warnings.clone();

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use crate::common::TempDir;
 use glam::{Vec2, Vec3};
 use image::{ImageFormat, Rgb, RgbImage, Rgba, RgbaImage};
-use lumiere::materials::CoverageTest;
+use lumiere::materials::{CoverageTest, Cut};
 use lumiere::render::fingerprint::scene_fingerprint;
 use lumiere::scene::Scene;
 use lumiere::textures::{EmbeddedImages, MAX_TEXELS, Texture, TextureSet, srgb_to_linear};
@@ -623,7 +623,8 @@ fn the_scene_fingerprint_holds_how_a_mask_cuts() {
         plain,
         fingerprint(Some(CoverageTest { alpha_only: true, ..CoverageTest::MTL })),
         fingerprint(Some(CoverageTest { scale: 0.5, ..CoverageTest::MTL })),
-        fingerprint(Some(CoverageTest { threshold: 0.3, ..CoverageTest::MTL })),
+        fingerprint(Some(CoverageTest { cut: Cut::Below(0.3), ..CoverageTest::MTL })),
+        fingerprint(Some(CoverageTest { cut: Cut::Hashed, ..CoverageTest::MTL })),
     ];
     for (i, a) in tests.iter().enumerate() {
         assert!(tests[i + 1..].iter().all(|b| a != b), "{tests:x?}");

@@ -2,12 +2,13 @@
 //! extension's mapping (a metal from `metallic ≥ 0.5`, otherwise a plastic with a 4% layer;
 //! GGX `α = roughness²`), `KHR_materials_transmission` onto smooth glass of `KHR_materials_ior`'s
 //! index, emission from `emissiveFactor` (times `KHR_materials_emissive_strength`), and the base
-//! colour texture with its placement, and `alphaMode MASK` as a cutout by the base colour's alpha.
+//! colour texture with its placement, and `alphaMode` `MASK` and `BLEND` as cutouts by the base
+//! colour's alpha.
 //! What is not honoured is named in one warning per material.
 //! docs/MATERIALS.md has the table.
 
 use crate::error::{shown_name, shown_path};
-use crate::materials::{CoverageTest, Material};
+use crate::materials::{CoverageTest, Cut, Material};
 use crate::math::UvTransform;
 use crate::scene::load::warnings::Warnings;
 use glam::{Vec2, Vec3};
@@ -107,25 +108,35 @@ pub(super) fn convert(
             .push("emissiveTexture (the material does not emit; --emission NAME=R,G,B makes it a light)".to_string());
     }
     let mut drawn = true;
-    if source.alpha_mode() == gltf::material::AlphaMode::Mask {
-        let cutoff = source.alpha_cutoff().unwrap_or(DEFAULT_ALPHA_CUTOFF);
-        drawn = mask(&mut material, alpha, cutoff);
-        if !drawn {
-            warnings.push(file, "materials cut out whole", || {
-                format!(
-                    "{}: material {}: alphaMode MASK cuts the whole surface out (baseColorFactor alpha {alpha} \
-                     below alphaCutoff {cutoff}, no texture); its primitives are not drawn",
-                    shown_path(file),
-                    shown_name(&name)
-                )
-            });
+    match source.alpha_mode() {
+        gltf::material::AlphaMode::Opaque => {}
+        gltf::material::AlphaMode::Mask => {
+            let cutoff = source.alpha_cutoff().unwrap_or(DEFAULT_ALPHA_CUTOFF);
+            drawn = cut_by_alpha(&mut material, alpha, Cut::Below(cutoff));
+            if !drawn {
+                warn_cut_whole(
+                    warnings,
+                    file,
+                    &name,
+                    &format!("MASK cuts it out (baseColorFactor alpha {alpha} below alphaCutoff {cutoff})"),
+                );
+            }
+        }
+        // A light is whole (see `Material::cutout_mask`).
+        gltf::material::AlphaMode::Blend if material.is_emissive() => {
+            not_read.push("alphaMode BLEND on an emitter (drawn opaque: a light is whole)".to_string());
+        }
+        gltf::material::AlphaMode::Blend => {
+            drawn = cut_by_alpha(&mut material, alpha, Cut::Hashed);
+            if !drawn {
+                warn_cut_whole(warnings, file, &name, "BLEND covers none of it (baseColorFactor alpha 0)");
+            }
         }
     }
     for (present, what) in [
         (pbr.metallic_roughness_texture().is_some(), "metallicRoughnessTexture"),
         (source.normal_texture().is_some(), "normalTexture"),
         (source.occlusion_texture().is_some(), "occlusionTexture"),
-        (source.alpha_mode() == gltf::material::AlphaMode::Blend, "alphaMode BLEND (drawn opaque)"),
     ] {
         if present {
             not_read.push(what.to_string());
@@ -143,21 +154,33 @@ pub(super) fn convert(
 /// glTF's `alphaCutoff` where a `MASK` material gives none.
 const DEFAULT_ALPHA_CUTOFF: f32 = 0.5;
 
-/// glTF's `alphaMode MASK` onto a cutout: the surface is there where the base colour's alpha, its
-/// texture's (read from the same texels as the colour) times its factor's `alpha`, reaches
-/// `cutoff`. Without a texture the factor decides for the whole surface: returns whether it is
-/// there.
-fn mask(material: &mut Material, alpha: f32, cutoff: f32) -> bool {
-    let test = CoverageTest { alpha_only: true, scale: alpha, threshold: cutoff };
-    match &material.map_kd {
-        Some(texture) => {
-            material.map_d = Some(texture.clone());
-            material.map_d_transform = material.map_kd_transform;
-            material.map_d_test = test;
-            true
-        }
-        None => test.keeps(1.0),
+/// glTF's `alphaMode` `MASK` or `BLEND` onto a cutout by the base colour's alpha, its texture's
+/// (read from the same texels as the colour) times its factor's `alpha`, cut as `cut` says.
+/// Without a texture the factor's alpha covers the whole surface alike: returns whether it covers
+/// any of it.
+fn cut_by_alpha(material: &mut Material, alpha: f32, cut: Cut) -> bool {
+    material.map_d_test = CoverageTest { alpha_only: true, scale: alpha, cut };
+    if let Some(texture) = &material.map_kd {
+        material.map_d = Some(texture.clone());
+        material.map_d_transform = material.map_kd_transform;
+        return true;
     }
+    match cut {
+        Cut::Below(cutoff) => alpha >= cutoff,
+        Cut::Hashed => alpha > 0.0,
+    }
+}
+
+/// Warns that `name`'s primitives are not drawn, its alpha mode covering none of its surface
+/// (`why`).
+fn warn_cut_whole(warnings: &mut Warnings, file: &Path, name: &str, why: &str) {
+    warnings.push(file, "materials cut out whole", || {
+        format!(
+            "{}: material {}: alphaMode {why}, without a texture: its primitives are not drawn",
+            shown_path(file),
+            shown_name(name)
+        )
+    });
 }
 
 /// The base colour texture's file, placement and coordinate set; what is not honoured of it goes
