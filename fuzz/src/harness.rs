@@ -150,9 +150,18 @@ pub fn gltf_target(data: &[u8]) -> Result<(), String> {
 
 /// An accepted glTF scene is consistent and finite like any mesh; no file was read (the reader
 /// refuses them all); every texture named as embedded in the file (`fuzz.gltf#imageN`) is in
-/// `embedded_images`; texture transforms are finite.
+/// `embedded_images`; texture transforms are finite; the scene's view (a camera) makes a camera
+/// with finite rays, as the CLI takes it.
 pub fn check_gltf_scene(scene: &Scene, file: &Path) -> Result<(), String> {
     check_mesh(&scene.mesh, &scene.materials, &scene.warnings)?;
+    if let Some(view) = &scene.view {
+        let camera = Camera::look_at(view.eye, view.target, view.up, view.fov_degrees, 8, 6)
+            .map_err(|error| format!("a view the camera refuses ({error}): {view:?}"))?;
+        let ray = camera.ray(0.0, 0.0);
+        if !(ray.origin.is_finite() && ray.dir.is_finite()) {
+            return Err(format!("a view whose rays are not finite ({ray:?}): {view:?}"));
+        }
+    }
     if !scene.sources.is_empty() {
         return Err(format!("files read through a reader that refuses them all: {:?}", scene.sources));
     }

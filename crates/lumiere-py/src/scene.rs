@@ -12,6 +12,7 @@ use lumiere::materials::Material;
 use lumiere::math::UvTransform;
 use lumiere::render::fingerprint::scene_fingerprint;
 use lumiere::scene::Scene;
+use lumiere::scene::camera::View;
 use lumiere::scene::load::memory::{MeshSize, check_arrays_memory};
 use lumiere::scene::mesh::TriangleMesh;
 use lumiere::world::World;
@@ -132,6 +133,13 @@ impl PyScene {
         self.world.scene().warnings.iter().chain(self.world.warnings()).cloned().collect()
     }
 
+    /// The view the scene file gives itself (a glTF camera) as a dict of `eye`, `target`, `up`,
+    /// `fov` (vertical, degrees) and `name`; None for a scene without one.
+    #[getter]
+    fn view<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        self.world.scene().view.as_ref().map(|view| view_dict(py, view)).transpose()
+    }
+
     /// Refuses a scene without a triangle, before a render (`Scene::check_has_faces`).
     fn check_has_faces(&self) -> PyResult<()> {
         self.world.scene().check_has_faces().or_py()
@@ -183,6 +191,7 @@ impl PyScene {
             materials.set_item(&material.name, entry)?;
         }
         info.set_item("materials", materials)?;
+        info.set_item("view", self.view(py)?)?;
         info.set_item("warnings", self.warnings())?;
         info.set_item("load_seconds", self.load_seconds)?;
         info.set_item("build_seconds", self.build_seconds)?;
@@ -193,6 +202,18 @@ impl PyScene {
         let scene = self.world.scene();
         format!("<lumiere scene {:?}: {} triangles>", scene.name, scene.mesh.triangle_count())
     }
+}
+
+/// A scene's view as Python sees it: vectors as tuples, which cannot be changed in place.
+fn view_dict<'py>(py: Python<'py>, view: &View) -> PyResult<Bound<'py, PyDict>> {
+    let tuple = |v: Vec3| (v.x, v.y, v.z);
+    let entry = PyDict::new(py);
+    entry.set_item("eye", tuple(view.eye))?;
+    entry.set_item("target", tuple(view.target))?;
+    entry.set_item("up", tuple(view.up))?;
+    entry.set_item("fov", view.fov_degrees)?;
+    entry.set_item("name", view.name.as_deref())?;
+    Ok(entry)
 }
 
 /// A texture's `-s` and `-o` as `{'scale': (u, v), 'offset': (u, v)}`, or `None` where they leave

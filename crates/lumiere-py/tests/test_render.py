@@ -2,6 +2,7 @@
 and Ctrl-C."""
 
 import contextlib
+import math
 import os
 import pickle
 import signal
@@ -177,6 +178,62 @@ def test_a_gltf_file_loads_pickles_and_renders(tmp_path):
     (tmp_path / "two data.bin").write_bytes(data[:-3])
     with pytest.raises(lumiere.LumiereError, match=r"two\.gltf: buffer 0: declares 84 bytes, but its data has 81"):
         lumiere.load(path)
+
+def test_a_gltf_camera_is_the_default_view(tmp_path):
+    # A camera node (half a turn about +Y, so looking down +Z) is the scene's view: render with
+    # camera=None draws what Camera.look_at of that view draws, bit for bit, and a Camera made of
+    # it pickles as a look-at. A file without a camera has no view, and renders framed.
+    import json
+
+    vertices = np.array([[-1, 0, -1], [1, 0, -1], [0, 0, 1], [-1, 2, -1], [1, 2, -1], [0, 2, 1]], dtype="<f4")
+    indices = np.array([0, 2, 1, 3, 4, 5], dtype="<u2")
+    data = vertices.tobytes() + indices.tobytes()
+    (tmp_path / "data.bin").write_bytes(data)
+    document = {
+        "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1]}],
+        "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0.5, 1.5, -4], "rotation": [0, 1, 0, 0]}],
+        "cameras": [{"name": "Main", "type": "perspective", "perspective": {"yfov": 0.7, "znear": 0.1}}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}],
+        "materials": [{"name": "panel", "pbrMetallicRoughness": {"metallicFactor": 0}}],
+        "buffers": [{"uri": "data.bin", "byteLength": len(data)}],
+        "bufferViews": [{"buffer": 0, "byteLength": 72}, {"buffer": 0, "byteOffset": 72, "byteLength": 12}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 6, "type": "VEC3"},
+                      {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"}],
+    }
+    with_camera = tmp_path / "camera.gltf"
+    with_camera.write_text(json.dumps(document))
+    del document["cameras"]
+    document["nodes"][1] = {}
+    plain = tmp_path / "plain.gltf"
+    plain.write_text(json.dumps(document))
+
+    scene = lumiere.load(with_camera, emission={"panel": (1, 1, 1)})
+    assert scene.warnings == []
+    view = scene.view
+    assert view["eye"] == (0.5, 1.5, -4.0) and view["name"] == "Main"
+    assert np.allclose(np.subtract(view["target"], view["eye"]) / 4, (0, 0, 1), atol=1e-6)
+    assert np.allclose(view["up"], (0, 1, 0), atol=1e-6)
+    assert view["fov"] == pytest.approx(math.degrees(0.7), abs=1e-4)
+    assert scene.info()["view"] == view
+
+    size = (16, 12)
+    explicit = lumiere.Camera.look_at(view["eye"], view["target"], view["up"], view["fov"], size)
+    image = lumiere.render(scene, spp=2, size=size)
+    assert image.max() > 0
+    assert np.array_equal(bits(image), bits(lumiere.render(scene, explicit, spp=2)))
+    framed = lumiere.render(scene, lumiere.Camera.framing(scene, size), spp=2)
+    assert not np.array_equal(bits(image), bits(framed))
+
+    camera = lumiere.Camera.scene_view(scene, size)
+    assert repr(camera) == repr(explicit)
+    again = pickle.loads(pickle.dumps(camera))
+    assert np.array_equal(bits(image), bits(lumiere.render(scene, again, spp=2)))
+
+    without = lumiere.load(plain, emission={"panel": (1, 1, 1)})
+    assert without.view is None and without.info()["view"] is None
+    assert np.array_equal(bits(lumiere.render(without, spp=2, size=size)), bits(framed))
+    with pytest.raises(lumiere.LumiereError, match=r"plain\.gltf: the scene has no view of its own"):
+        lumiere.Camera.scene_view(without, size)
 
 
 def grey_png(path, values):

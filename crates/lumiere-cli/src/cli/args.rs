@@ -207,7 +207,8 @@ pub struct RenderArgs {
     #[arg(long, conflicts_with_all = ["eye", "target"])]
     pub orbiter: Option<PathBuf>,
 
-    /// Look-at camera position, x,y,z (needs --target). Without a camera, the view frames the scene.
+    /// Look-at camera position, x,y,z (needs --target). Without a camera, a glTF scene is seen from
+    /// its first perspective camera, if it has one; otherwise the view frames the scene.
     #[arg(long, value_parser = parse_vec3, requires = "target", allow_hyphen_values = true)]
     pub eye: Option<Vec3>,
 
@@ -215,12 +216,13 @@ pub struct RenderArgs {
     #[arg(long, value_parser = parse_vec3, requires = "eye", allow_hyphen_values = true)]
     pub target: Option<Vec3>,
 
-    /// Look-at camera up direction, x,y,z (also for the view that frames a scene). [default: 0,1,0]
+    /// Look-at camera up direction, x,y,z (also for the view that frames a scene, and in place of a
+    /// glTF camera's). [default: 0,1,0]
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
     pub up: Option<Vec3>,
 
     /// Vertical field of view of the look-at camera, in degrees, between 0 and 180 (exclusive);
-    /// orbiter cameras use gKit's 45. [default: 45]
+    /// orbiter cameras use gKit's 45. [default: 45, or a glTF camera's own]
     #[arg(long, value_parser = parse_fov, allow_hyphen_values = true)]
     pub fov: Option<f32>,
 

@@ -7,10 +7,12 @@ use std::time::Instant;
 use glam::Vec3;
 
 use lumiere::Result;
+use lumiere::error::quote;
 use lumiere::lights::LightSet;
 use lumiere::materials::{CoverageTest, Cut, Material, MaterialKind};
 use lumiere::math::UvTransform;
 use lumiere::scene::Scene;
+use lumiere::scene::camera::View;
 use lumiere::textures::TextureSet;
 
 use super::args::InfoArgs;
@@ -54,6 +56,9 @@ pub fn run(args: &InfoArgs) -> Result<()> {
         line("bounds", "empty")?;
     } else {
         line("bounds", format!("{} .. {}", vector(bounds.min), vector(bounds.max)))?;
+    }
+    if let Some(view) = &scene.view {
+        line("view", described_view(view))?;
     }
     line("load", format!("{load_ms:.1} ms"))?;
     line("materials", scene.materials.len())?;
@@ -115,6 +120,18 @@ fn cut(test: CoverageTest, coverage: &str) -> String {
         }
         Cut::Hashed => format!("covering {coverage} x {} of the surface, hashed", number(test.scale)),
     }
+}
+
+/// The scene file's own view as `--eye`, `--target`, `--up` and `--fov` would give it.
+fn described_view(view: &View) -> String {
+    let name = view.name.as_deref().map(|name| format!("{} ", quote(name))).unwrap_or_default();
+    format!(
+        "{name}eye {}, target {}, up {}, fov {} degrees",
+        vector(view.eye),
+        vector(view.target),
+        vector(view.up),
+        number(view.fov_degrees)
+    )
 }
 
 /// A texture's `-s` and `-o` as the MTL writes them, where they move it.

@@ -423,6 +423,80 @@ fn a_glb_scene_renders_as_its_obj_twin() {
     assert_refused(&dir, &["render", cut.to_str().unwrap()], "cut.glb: GLB: the header gives a length of");
 }
 
+/// A glTF scene whose node tree places a camera renders from it when no camera is given, byte for
+/// byte as the same look-at given in flags; `--fov` replaces its field of view, `--eye` and
+/// `--target` replace it, and `lumiere info` shows it.
+#[test]
+fn a_gltf_camera_is_the_default_view_and_camera_flags_override_it() {
+    let dir = TempDir::new("gltf-camera");
+    let floor = [[-1.0f32, 0.0, -1.0], [1.0, 0.0, -1.0], [1.0, 0.0, 1.0], [-1.0, 0.0, 1.0]];
+    let block = [[-0.5f32, 0.0, 0.0], [0.5, 0.0, 0.0], [0.0, 1.0, 0.5]];
+    let mut bin: Vec<u8> = floor.iter().chain(&block).flatten().flat_map(|c| c.to_le_bytes()).collect();
+    bin.extend([0u16, 2, 1, 0, 3, 2, 0, 1, 2, 0].iter().flat_map(|i| i.to_le_bytes()));
+    dir.write("scene.bin", &bin);
+    let gltf = |camera_node: &str, cameras: &str| {
+        format!(
+            r#"{{"asset": {{"version": "2.0"}}, "scene": 0, "scenes": [{{"nodes": [0, 1]}}],
+            "nodes": [{{"mesh": 0}}, {camera_node}], "cameras": [{cameras}],
+            "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}, "indices": 2, "material": 0}},
+                {{"attributes": {{"POSITION": 1}}, "indices": 3, "material": 1}}]}}],
+            "materials": [{{"pbrMetallicRoughness": {{"baseColorFactor": [0.2, 0.6, 0.8, 1], "metallicFactor": 0}}}},
+                {{"pbrMetallicRoughness": {{"baseColorFactor": [0.9, 0.3, 0.1, 1], "metallicFactor": 0}}}}],
+            "buffers": [{{"byteLength": {}, "uri": "scene.bin"}}],
+            "bufferViews": [{{"buffer": 0, "byteLength": 48}}, {{"buffer": 0, "byteOffset": 48, "byteLength": 36}},
+                {{"buffer": 0, "byteOffset": 84, "byteLength": 12}}, {{"buffer": 0, "byteOffset": 96, "byteLength": 6}}],
+            "accessors": [{{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3"}},
+                {{"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC3"}},
+                {{"bufferView": 2, "componentType": 5123, "count": 6, "type": "SCALAR"}},
+                {{"bufferView": 3, "componentType": 5123, "count": 3, "type": "SCALAR"}}]}}"#,
+            bin.len()
+        )
+    };
+    // Half a turn about +Y: the camera at z = -4 looks down +Z, at the floor and the block.
+    let node = r#"{"camera": 0, "translation": [0.5, 1.5, -4], "rotation": [0, 1, 0, 0]}"#;
+    let camera = r#"{"type": "perspective", "perspective": {"yfov": 0.6, "znear": 0.1, "aspectRatio": 2}}"#;
+    let with_camera = dir.write("camera.gltf", gltf(node, camera));
+    let without = dir.write("plain.gltf", gltf("{}", ""));
+    // The view's field of view as the loader converts it, printed so that it parses back to itself.
+    let fov = format!("{}", f64::from(0.6f32).to_degrees() as f32);
+    let explicit = ["--eye", "0.5,1.5,-4", "--target", "0.5,1.5,0", "--up", "0,1,0"];
+    let render = |scene: &Path, flags: &[&str], name: &str| {
+        let out = dir.arg(name);
+        let args = ["render", scene.to_str().unwrap(), "--mode", "materials", "--size", "48x24", "-o", &out];
+        let run = lumiere(&args.iter().chain(flags).copied().collect::<Vec<_>>());
+        assert!(run.status.success(), "{name}: {}", stderr(&run));
+        assert!(!stderr(&run).contains("warning"), "{name}: {}", stderr(&run));
+        fs::read(&out).unwrap()
+    };
+    let from_file = render(&with_camera, &[], "file.pfm");
+    let given: Vec<&str> = explicit.iter().copied().chain(["--fov", &fov]).collect();
+    assert!(from_file == render(&without, &given, "given.pfm"), "the file's camera is not the flags' look-at");
+    let framed = render(&without, &[], "framed.pfm");
+    assert!(from_file != framed, "the file's camera renders as the framing view");
+
+    let narrower = render(&with_camera, &["--fov", "20"], "narrower.pfm");
+    let given: Vec<&str> = explicit.iter().copied().chain(["--fov", "20"]).collect();
+    assert!(narrower == render(&without, &given, "given-narrower.pfm"), "--fov does not replace the file's");
+    assert!(narrower != from_file, "--fov changes nothing");
+
+    let elsewhere = ["--eye", "2,3,3", "--target", "0,0,0"];
+    let overridden = render(&with_camera, &elsewhere, "overridden.pfm");
+    assert!(
+        overridden == render(&without, &elsewhere, "elsewhere.pfm"),
+        "--eye/--target do not replace the file's camera"
+    );
+    assert!(overridden != from_file, "--eye/--target change nothing");
+
+    let info = lumiere(&["info", with_camera.to_str().unwrap()]);
+    assert!(info.status.success(), "{}", stderr(&info));
+    let text = String::from_utf8_lossy(&info.stdout);
+    let expected = "view       eye (0.500000, 1.500000, -4.000000), target (0.500000, 1.500000, 0.000000), up (0.000000, \
+                    1.000000, 0.000000), fov 34.377468 degrees";
+    assert!(text.contains(expected), "{text}");
+    let plain = lumiere(&["info", without.to_str().unwrap()]);
+    assert!(!String::from_utf8_lossy(&plain.stdout).contains("view"), "a scene without a camera shows a view");
+}
+
 #[test]
 fn bad_inputs_give_a_clear_error_and_no_file() {
     let dir = TempDir::new("bad");

@@ -21,6 +21,9 @@ class NativeScene:
     def name(self) -> str: ...
     @property
     def warnings(self) -> List[str]: ...
+    @property
+    def view(self) -> Optional[Dict[str, Any]]:
+        """The scene file's own view (a glTF camera): eye, target, up, fov (degrees), name."""
     @staticmethod
     def load(path: Optional[_Path], emission: Sequence[Tuple[str, _Vec3]]) -> NativeScene:
         """An OBJ file, or the built-in Cornell box when ``path`` is None; emission applied."""

@@ -100,7 +100,9 @@ def _camera(scene: Scene, camera: Optional[Camera], size: Optional[Tuple[int, in
             raise TypeError(f"camera must be a lumiere.Camera, got {type(camera).__name__}")
         return camera
     size = DEFAULT_SIZE if size is None else size
-    return Camera.builtin(size) if scene.is_builtin else Camera.framing(scene, size)
+    if scene.is_builtin:
+        return Camera.builtin(size)
+    return Camera.framing(scene, size) if scene.view is None else Camera.scene_view(scene, size)
 
 
 def _threads(threads: int) -> int:
@@ -185,8 +187,9 @@ def render(
     row 0 at the top: the values ``lumiere render -o image.pfm`` writes for the same options.
 
     :param camera: a :class:`Camera`; None: the built-in scene's orbiter for
-        :func:`lumiere.builtin`, a view framing the scene otherwise (both ``size`` pixels,
-        default 1024x768).
+        :func:`lumiere.builtin`, the scene file's own view where it has one (:attr:`Scene.view`,
+        a glTF camera), a view framing the scene otherwise (all ``size`` pixels, default
+        1024x768).
     :param mode: ``path`` (global illumination), or the lab's ``hits``, ``materials``,
         ``shadows``, ``direct``, ``ao``.
     :param spp: camera samples per pixel (1 = the lab's pixel centres, more are jittered). None

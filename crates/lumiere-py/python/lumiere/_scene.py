@@ -263,8 +263,16 @@ class Scene:
         """What ``lumiere info`` prints: ``name``, ``triangles``, ``vertices``, ``materials`` (by
         name: ``triangles``, ``kd``, ``ke``, ``texture``, ``cutout`` (its ``map_d`` mask),
         ``light``), ``lights`` (``triangles``, ``area``, ``power``), ``bounds`` (``(min, max)`` or
-        None), ``warnings``, load and build seconds."""
+        None), ``view`` (see :attr:`view`), ``warnings``, load and build seconds."""
         return self._native.info()
+
+    @property
+    def view(self) -> Optional[Dict[str, Any]]:
+        """The view the scene file gives itself, which :func:`lumiere.render` uses with
+        ``camera=None``: a glTF file's first perspective camera, as a new dict of ``eye``,
+        ``target``, ``up`` (tuples), ``fov`` (vertical, degrees) and ``name`` (None if unnamed);
+        None for OBJ, PLY, arrays, the built-in scene and glTF files without a camera."""
+        return self._native.view
 
     @property
     def name(self) -> str:
@@ -356,7 +364,7 @@ def _rebuild_scene(recipe: tuple) -> Scene:
 def load(path: PathLike, emission: Optional[Mapping[str, Vector]] = None) -> Scene:
     """Loads a scene file: Wavefront OBJ (``.obj`` or ``.obj.gz``, with its MTL files and
     textures), glTF 2.0 (``.gltf`` with its buffers and images, or ``.glb``: its node tree,
-    meshes and metallic-roughness materials) or PLY (``.ply`` or ``.ply.gz``: its vertices,
+    meshes, metallic-roughness materials and first perspective camera, :attr:`Scene.view`) or PLY (``.ply`` or ``.ply.gz``: its vertices,
     normals and faces, with one grey material named ``default``).
 
     :param emission: sets the emitted radiance of materials by name, as ``--emission`` does:
@@ -427,6 +435,22 @@ class Camera:
             raise TypeError(f"scene must be a lumiere.Scene, got {type(scene).__name__}")
         eye, target = _lumiere.NativeCamera.framing(scene._native, _float32(fov, "fov"))
         return cls.look_at(eye, target, up, fov, size)
+
+    @classmethod
+    def scene_view(cls, scene: Scene, size: Tuple[int, int] = DEFAULT_SIZE) -> "Camera":
+        """The look-at camera of the view the scene file gives itself (:attr:`Scene.view`, a glTF
+        camera): what :func:`lumiere.render` and the CLI use for such a scene given without a
+        camera. ``size`` decides the horizontal field of view (the file's aspect ratio is not read).
+
+        :raises LumiereError: the scene has no view of its own.
+        """
+        if not isinstance(scene, Scene):
+            raise TypeError(f"scene must be a lumiere.Scene, got {type(scene).__name__}")
+        view = scene.view
+        if view is None:
+            raise LumiereError(f"{scene.name}: the scene has no view of its own (no glTF camera); use Camera.framing")
+        # Made as a look-at, so that it pickles without the scene.
+        return cls.look_at(view["eye"], view["target"], view["up"], view["fov"], size)
 
     @property
     def size(self) -> Tuple[int, int]:

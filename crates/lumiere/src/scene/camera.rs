@@ -302,6 +302,22 @@ impl Camera {
     }
 }
 
+/// The view a scene file gives itself (a glTF camera): a look-at camera less its image size. The
+/// size decides the horizontal field of view, as for every look-at camera (a glTF camera's
+/// `aspectRatio` is not read).
+#[derive(Clone, Debug, PartialEq)]
+pub struct View {
+    pub eye: Vec3,
+    /// A point on the view's axis (where the target lies along it does not change the view).
+    pub target: Vec3,
+    /// Unit, though not always square to the axis: [`Camera::look_at`] squares it.
+    pub up: Vec3,
+    /// The vertical field of view, in degrees.
+    pub fov_degrees: f32,
+    /// The name the file gives the camera (else its node), for the user to recognise it.
+    pub name: Option<String>,
+}
+
 /// The eye and target of a view from +z that frames all of `bounds` (its bounding sphere fills the
 /// vertical field of view `fov_degrees`): the camera front ends use when none is given. Refused,
 /// with the reason, for empty bounds, a field of view out of range or too narrow to frame them

@@ -14,6 +14,7 @@ use crate::error::{Error, Result, shown_name};
 use crate::materials::Material;
 use crate::math::Aabb;
 use crate::textures::EmbeddedImages;
+use camera::View;
 use mesh::TriangleMesh;
 
 /// A loaded scene: triangles in file order and their materials. Lights, the BVH and everything
@@ -31,6 +32,9 @@ pub struct Scene {
     /// The images the scene file carries inside itself (glTF), under the names its materials'
     /// `map_kd` give them in place of a file's path.
     pub embedded_images: EmbeddedImages,
+    /// The view the scene file gives itself (a glTF camera), which front ends use when the user
+    /// gives no camera; `None` from OBJ, PLY, arrays and the built-in scene.
+    pub view: Option<View>,
 }
 
 impl Scene {
@@ -98,7 +102,15 @@ impl Scene {
                 warnings.push(format!("{name}: material {}: {clamped}", shown_name(&material.name)));
             }
         }
-        Ok(Scene { name, mesh, materials, warnings, sources: Vec::new(), embedded_images: EmbeddedImages::default() })
+        Ok(Scene {
+            name,
+            mesh,
+            materials,
+            warnings,
+            sources: Vec::new(),
+            embedded_images: EmbeddedImages::default(),
+            view: None,
+        })
     }
 
     /// Sets the emission of every material called `name`.

@@ -25,7 +25,7 @@ const SHORT: u32 = 5122;
 /// A glTF file under construction: one binary buffer with its views and accessors, written as a
 /// `.gltf` (the buffer a base64 `data:` URI) or as a `.glb` (the buffer its binary chunk).
 #[derive(Default)]
-struct Builder {
+pub(super) struct Builder {
     blob: Vec<u8>,
     views: Vec<String>,
     accessors: Vec<String>,
@@ -64,7 +64,7 @@ impl Builder {
     }
 
     /// Floats, `kind` (`VEC3`, `VEC2`) elements of them, in a view of their own.
-    fn floats(&mut self, values: &[f32], kind: &str) -> usize {
+    pub(super) fn floats(&mut self, values: &[f32], kind: &str) -> usize {
         let per = match kind {
             "VEC2" => 2,
             "VEC3" => 3,
@@ -75,7 +75,7 @@ impl Builder {
         self.accessor(Some(view), 0, FLOAT, values.len() / per, kind, "")
     }
 
-    fn indices(&mut self, values: &[u16]) -> usize {
+    pub(super) fn indices(&mut self, values: &[u16]) -> usize {
         let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
         let view = self.view(&bytes, None);
         self.accessor(Some(view), 0, UNSIGNED_SHORT, values.len(), "SCALAR", "")
@@ -99,7 +99,7 @@ impl Builder {
         format!(r#"{{"asset": {{"version": "2.0"}}, {members}{rest}}}"#)
     }
 
-    fn gltf(&self, rest: &str) -> Vec<u8> {
+    pub(super) fn gltf(&self, rest: &str) -> Vec<u8> {
         let data = base64::engine::general_purpose::STANDARD.encode(&self.blob);
         self.json(rest, Some(&format!("data:application/octet-stream;base64,{data}"))).into_bytes()
     }
@@ -129,7 +129,7 @@ fn glb(json: &[u8], bin: Option<&[u8]>) -> Vec<u8> {
     out
 }
 
-fn no_files(path: &Path) -> io::Result<Vec<u8>> {
+pub(super) fn no_files(path: &Path) -> io::Result<Vec<u8>> {
     Err(io::Error::new(io::ErrorKind::NotFound, format!("{} is not there", path.display())))
 }
 
@@ -634,7 +634,7 @@ fn what_is_not_drawn_is_named_in_warnings() {
     let points = primitive.replace(r#""indices""#, r#""mode": 0, "indices""#);
     let rest = format!(
         r#""meshes": [{{"primitives": [{primitive}, {points}]}}], "nodes": [{{"mesh": 0}}, {{"camera": 0}}, {{"mesh": 0}}],
-        "cameras": [{{"type": "perspective", "perspective": {{"yfov": 0.8, "znear": 0.1}}}}],
+        "cameras": [{{"type": "orthographic", "orthographic": {{"xmag": 1, "ymag": 1, "znear": 0.1, "zfar": 9}}}}],
         "scenes": [{{"nodes": [0, 1, 2]}}, {{"name": "other", "nodes": []}}], "scene": 0,
         "materials": [{{"name": "rough", "normalTexture": {{"index": 0}},
             "emissiveFactor": [1, 1, 1], "emissiveTexture": {{"index": 0}}}}],
@@ -648,7 +648,7 @@ fn what_is_not_drawn_is_named_in_warnings() {
     let expected = [
         r#"test.gltf: extensions not read: "KHR_materials_clearcoat", "KHR_lights_punctual""#,
         "test.gltf: the file has 2 scenes; drawing scene 0",
-        "test.gltf: not read: cameras (frame the view with --eye and --target)",
+        "test.gltf: camera 0 of node 1: orthographic camera not read (lumiere has no orthographic projection)",
         "test.gltf: material 'rough': not read: emissiveTexture (the material does not emit; --emission NAME=R,G,B \
          makes it a light), normalTexture",
         "test.gltf: mesh 0 primitive 1: Points are not drawn (lumiere draws triangles)",

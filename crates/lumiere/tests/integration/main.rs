@@ -10,6 +10,7 @@ mod checkpoint;
 mod cutouts;
 mod estimators;
 mod film;
+mod gltf_cameras;
 mod gltf_loading;
 mod hard_shadows;
 mod hostile_inputs;

@@ -7,7 +7,8 @@ use lumiere::{Error, Result};
 
 use crate::cli::args::RenderArgs;
 
-/// An orbiter file, a look-at, the built-in scene's orbiter, or a view that frames the whole scene.
+/// An orbiter file, a look-at, the built-in scene's orbiter, the scene file's own view (a glTF
+/// camera; `--fov` and `--up` replace its own), or a view that frames the whole scene.
 pub fn from_args(args: &RenderArgs, scene: &Scene) -> Result<Camera> {
     let (width, height) = args.size;
     let fov = args.fov.unwrap_or(super::options::DEFAULT_FOV);
@@ -19,6 +20,10 @@ pub fn from_args(args: &RenderArgs, scene: &Scene) -> Result<Camera> {
     }
     if args.scene.is_none() {
         return Ok(Camera::from_orbiter(&builtin::cornell_orbiter()?, width, height));
+    }
+    if let Some(view) = &scene.view {
+        let (up, fov) = (args.up.unwrap_or(view.up), args.fov.unwrap_or(view.fov_degrees));
+        return Camera::look_at(view.eye, view.target, up, fov, width, height);
     }
     let (eye, target) = camera::framing(&scene.bounds(), fov)
         .map_err(|why| Error::invalid(format!("{}: {why}; give --eye and --target", scene.name)))?;

@@ -8,10 +8,12 @@
 //! (`accessor.rs`); the metallic-roughness materials with their base colour textures, glass from
 //! `KHR_materials_transmission`, emission, and `alphaMode MASK` as cutouts (`materials.rs`). A
 //! node whose transform mirrors (negative determinant) has its triangles' corners swapped, so that
-//! a face keeps its front.
-//! Anything else (points and lines, cameras, skins, animations, morph targets, unsupported
-//! extensions and material properties) is named in a warning, never silently dropped; a file that
-//! *requires* an extension lumiere does not read is refused.
+//! a face keeps its front. The first perspective camera the node tree places is the scene's view
+//! (`cameras.rs`: its position, direction and vertical field of view; not its aspect ratio or
+//! clipping planes). Anything else (points and lines, orthographic and further cameras, skins,
+//! animations, morph targets, unsupported extensions and material properties) is named in a
+//! warning, never silently dropped; a file that *requires* an extension lumiere does not read is
+//! refused.
 //!
 //! Every byte range is checked before it is read, and the whole flattened scene is refused before
 //! its triangles are allocated when its mesh and BVH would not fit in the memory left (instancing
@@ -19,6 +21,7 @@
 
 mod accessor;
 mod buffers;
+mod cameras;
 mod container;
 mod materials;
 mod nodes;
@@ -67,7 +70,9 @@ fn parse_within(bytes: &[u8], file: &Path, read: ReadFile, memory: Memory) -> Re
     let mut warnings = Warnings::default();
     warn_unread(document, file, &mut warnings);
     let buffers = buffers::load(&container, file, read)?;
-    let instances = nodes::instances(document, file, &mut warnings)?;
+    let walked = nodes::walk(document, file, &mut warnings)?;
+    let view = cameras::view(document, &walked.cameras, file, &mut warnings);
+    let instances = walked.instances;
     let meshes: Vec<gltf::Mesh> = document.meshes().collect();
 
     let mut embedded = EmbeddedImages::default();
@@ -109,6 +114,7 @@ fn parse_within(bytes: &[u8], file: &Path, read: ReadFile, memory: Memory) -> Re
     let mut scene = Scene::from_parts(shown_path(file), mesh, materials, warnings.finish())?;
     scene.sources = buffers.files;
     scene.embedded_images = embedded;
+    scene.view = view;
     Ok(scene)
 }
 
@@ -387,7 +393,6 @@ fn warn_unread(document: &gltf::Document, file: &Path, warnings: &mut Warnings) 
     }
     let morphs = document.meshes().flat_map(|m| m.primitives()).any(|p| p.morph_targets().len() > 0);
     for (count, what) in [
-        (document.cameras().len(), "cameras (frame the view with --eye and --target)"),
         (document.skins().len(), "skins (meshes are drawn in their bind pose)"),
         (document.animations().len(), "animations (the scene is drawn at rest)"),
         (usize::from(morphs), "morph targets (meshes are drawn without them)"),

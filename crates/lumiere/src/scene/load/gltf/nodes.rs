@@ -1,6 +1,6 @@
-//! The meshes a glTF scene draws and where: its node tree walked from the scene's roots, each
-//! node's transform composed with its parents' (in double precision), one instance per node with a
-//! mesh. A node reached twice (two parents, or its own ancestor) is refused: the format requires a
+//! The meshes a glTF scene draws and where, and the cameras it places: its node tree walked from
+//! the scene's roots, each node's transform composed with its parents' (in double precision), one
+//! instance per node with a mesh, one placed camera per node with a camera. A node reached twice (two parents, or its own ancestor) is refused: the format requires a
 //! tree, and a graph could make a few bytes expand without end.
 
 use crate::error::{Error, Result, quote, shown_path};
@@ -17,10 +17,25 @@ pub(super) struct Instance {
     pub(super) transform: DMat4,
 }
 
-/// Every mesh the file's scene draws, in the order of a depth-first walk from its roots (children
-/// in the order the file lists them). The scene is the file's `scene`, else its first; a file
-/// without scenes draws every node that is no node's child.
-pub(super) fn instances(document: &Document, file: &Path, warnings: &mut Warnings) -> Result<Vec<Instance>> {
+/// One camera placed by one node.
+pub(super) struct PlacedCamera {
+    pub(super) node: usize,
+    pub(super) camera: usize,
+    /// From the camera's coordinates to the scene's.
+    pub(super) transform: DMat4,
+}
+
+/// What the walk of the node tree found, each list in the walk's order.
+pub(super) struct Walked {
+    pub(super) instances: Vec<Instance>,
+    pub(super) cameras: Vec<PlacedCamera>,
+}
+
+/// Every mesh the file's scene draws and every camera it places, in the order of a depth-first
+/// walk from its roots (a node before its children, children in the order the file lists them,
+/// roots in the scene's order). The scene is the file's `scene`, else its first; a file without
+/// scenes draws every node that is no node's child, in the file's order.
+pub(super) fn walk(document: &Document, file: &Path, warnings: &mut Warnings) -> Result<Walked> {
     let scene = document.default_scene().or_else(|| document.scenes().next());
     let roots: Vec<usize> = match &scene {
         Some(scene) => scene.nodes().map(|node| node.index()).collect(),
@@ -44,7 +59,7 @@ pub(super) fn instances(document: &Document, file: &Path, warnings: &mut Warning
     let nodes: Vec<gltf::Node> = document.nodes().collect();
     let mut reached = vec![false; nodes.len()];
     let mut stack: Vec<(usize, DMat4)> = roots.iter().rev().map(|&root| (root, DMat4::IDENTITY)).collect();
-    let mut instances = Vec::new();
+    let (mut instances, mut cameras) = (Vec::new(), Vec::new());
     while let Some((index, parent)) = stack.pop() {
         if std::mem::replace(&mut reached[index], true) {
             return Err(Error::invalid(format!(
@@ -62,7 +77,10 @@ pub(super) fn instances(document: &Document, file: &Path, warnings: &mut Warning
         if let Some(mesh) = node.mesh() {
             instances.push(Instance { node: index, mesh: mesh.index(), transform });
         }
+        if let Some(camera) = node.camera() {
+            cameras.push(PlacedCamera { node: index, camera: camera.index(), transform });
+        }
         stack.extend(node.children().map(|child| (child.index(), transform)).collect::<Vec<_>>().into_iter().rev());
     }
-    Ok(instances)
+    Ok(Walked { instances, cameras })
 }
