@@ -364,8 +364,9 @@ def _rebuild_scene(recipe: tuple) -> Scene:
 def load(path: PathLike, emission: Optional[Mapping[str, Vector]] = None) -> Scene:
     """Loads a scene file: Wavefront OBJ (``.obj`` or ``.obj.gz``, with its MTL files and
     textures), glTF 2.0 (``.gltf`` with its buffers and images, or ``.glb``: its node tree,
-    meshes, metallic-roughness materials and first perspective camera, :attr:`Scene.view`) or PLY (``.ply`` or ``.ply.gz``: its vertices,
-    normals and faces, with one grey material named ``default``).
+    meshes, metallic-roughness materials and first perspective camera, :attr:`Scene.view`) or
+    PLY (``.ply`` or ``.ply.gz``: its vertices, normals and faces, with one grey material named
+    ``default``).
 
     :param emission: sets the emitted radiance of materials by name, as ``--emission`` does:
         ``{"Light": (17, 12, 4)}``; a name the scene lacks is an error.

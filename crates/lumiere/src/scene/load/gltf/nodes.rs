@@ -1,7 +1,8 @@
 //! The meshes a glTF scene draws and where, and the cameras it places: its node tree walked from
 //! the scene's roots, each node's transform composed with its parents' (in double precision), one
-//! instance per node with a mesh, one placed camera per node with a camera. A node reached twice (two parents, or its own ancestor) is refused: the format requires a
-//! tree, and a graph could make a few bytes expand without end.
+//! instance per node with a mesh, one placed camera per node with a camera. A node reached twice
+//! (two parents, or its own ancestor) is refused: the format requires a tree, and a graph could
+//! make a few bytes expand without end.
 
 use crate::error::{Error, Result, quote, shown_path};
 use crate::scene::load::warnings::Warnings;
