@@ -287,8 +287,8 @@ impl World {
         self.accel.occluded(ray)
     }
 
-    /// Whether a material has a coverage texture that may cut its surface out: then each ray is
-    /// traced alone, and each hit on a cutout material is tested against its texture.
+    /// Whether a material may be cut out (see [`Cutout::may_cut`]): then each ray is traced alone,
+    /// and each hit on a cutout material is tested against its coverage.
     #[inline]
     fn has_cutouts(&self) -> bool {
         self.cuts
@@ -300,8 +300,9 @@ impl World {
     }
 
     /// Whether triangle `id` is there at barycentrics `(u, v)` of its second and third corners:
-    /// false where its material's coverage texture (`map_d`) fails the material's test (below one
-    /// half, for MTL), the alpha test of cutout leaves and fences.
+    /// false where its material's coverage (its `map_d` texture's, or 1) fails the material's test
+    /// (below one half, for MTL), the alpha test of cutout leaves and fences; for glTF's `BLEND`,
+    /// against a hash of the hit.
     fn opaque_at(&self, id: u32, u: f32, v: f32) -> bool {
         let material = self.scene.mesh.material_ids[id as usize] as usize;
         let Some(Cutout { texture, test }) = self.cutout_of_material[material] else { return true };

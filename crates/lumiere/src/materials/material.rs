@@ -52,7 +52,8 @@ pub struct Material {
     pub map_d: Option<PathBuf>,
     /// Where `map_d` lies on the surface (its `-s` and `-o` options).
     pub map_d_transform: UvTransform,
-    /// How `map_d`'s coverage is read and where it cuts: MTL's rule, or glTF's `alphaMode MASK`.
+    /// How `map_d`'s coverage is read and where it cuts: MTL's rule, or glTF's `alphaMode` `MASK`
+    /// or `BLEND`, whose factor's alpha cuts even without a texture.
     pub map_d_test: CoverageTest,
     /// Index of refraction (MTL `Ni`) of a transmissive material.
     pub ni: f32,
@@ -83,6 +84,7 @@ pub struct CoverageTest {
     pub alpha_only: bool,
     /// What the coverage is multiplied by: glTF's `baseColorFactor` alpha; 1 for MTL.
     pub scale: f32,
+    /// Where the scaled coverage cuts.
     pub cut: Cut,
 }
 
