@@ -1,7 +1,8 @@
 //! Cutouts (`map_d`): rays pass through a surface where its coverage texture is below one half, in
 //! every query and every technique. A fully opaque mask must give the bytes of no mask, and a fully
 //! clear one the bytes of a scene without that surface, on every ISA: the per-ray paths that
-//! cutouts take must answer like the packets and batches they replace.
+//! cutouts take must answer like the packets and batches they replace. A hashed veil (glTF's
+//! `BLEND`) must give the same bytes on every ISA and cover its share.
 
 use std::path::PathBuf;
 
@@ -9,7 +10,7 @@ use glam::{Vec2, Vec3};
 use image::{GrayImage, ImageFormat, Luma, Rgba, RgbaImage};
 use lumiere::accel::{BuildPreset, Isa};
 use lumiere::integrators::{AmbientOcclusion, Hits, Materials, Path as PathTracer, Shadows, Technique};
-use lumiere::materials::Material;
+use lumiere::materials::{CoverageTest, Cut, Material};
 use lumiere::math::Ray;
 use lumiere::render::{RenderOptions, render};
 use lumiere::scene::Scene;
@@ -124,6 +125,41 @@ fn a_clear_mask_renders_the_bytes_of_no_blocker_on_every_isa() {
         let differ = images(&with, isa).iter().zip(&expected).filter(|(a, b)| a != b).count();
         assert_eq!(differ, techniques().len() - 2, "{isa}: the blocker is invisible");
     }
+}
+
+/// glTF's `BLEND` without a texture: the blocker covers half of itself, each point kept or cut by a
+/// hash of the hit, so the image is the same bytes on every ISA, and about half the pixels that
+/// see the blocker without a veil see it through one.
+#[test]
+fn a_hashed_veil_renders_the_same_bytes_on_every_isa_and_covers_its_share() {
+    let mut veil = scene(None, false);
+    veil.materials[2].map_d_test = CoverageTest { alpha_only: true, scale: 0.5, cut: Cut::Hashed };
+    let isas = Isa::supported();
+    let first = images(&veil, isas[0]);
+    for &isa in &isas[1..] {
+        for (k, (g, e)) in images(&veil, isa).iter().zip(&first).enumerate() {
+            assert!(g == e, "{isa}: technique {:?} differs from {}'s", techniques()[k].0, isas[0]);
+        }
+    }
+    // The materials image (pixel centres) from above: where the blocker shows without a veil, the
+    // veil's image shows either it or the floor, about half of each.
+    let camera = Camera::look_at(Vec3::new(0.0, 3.0, 0.01), Vec3::ZERO, Vec3::Y, 40.0, 120, 120).unwrap();
+    let options = RenderOptions::new(Technique::Materials(Materials));
+    let [veiled, with, without] = [veil, scene(None, false), scene(None, true)].map(|scene| {
+        let world = World::new(scene, BuildPreset::Default);
+        render(&world, &camera, &options, &|_| {}).unwrap().image.pixels
+    });
+    let covered: Vec<bool> = (0..with.len())
+        .filter(|&p| with[p] != without[p])
+        .map(|p| {
+            assert!(veiled[p] == with[p] || veiled[p] == without[p], "pixel {p}: {}", veiled[p]);
+            veiled[p] == with[p]
+        })
+        .collect();
+    let share = covered.iter().filter(|&&c| c).count() as f64 / covered.len() as f64;
+    // At least 2,000 pixels: the share's standard deviation is at most 0.011; allow five of them.
+    assert!(covered.len() > 2000, "only {} pixels see the blocker", covered.len());
+    assert!((share - 0.5).abs() < 0.056, "{share} of {} pixels see the veil", covered.len());
 }
 
 #[test]
