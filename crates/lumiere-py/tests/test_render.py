@@ -148,25 +148,33 @@ def test_a_binary_ply_file_renders_as_the_same_arrays(tmp_path):
         lumiere.load(ply)
 
 
+def two_panels_gltf(buffer_file, uri, nodes, roots):
+    """A glTF document of two triangles (material ``panel``, mesh 0) drawn by ``nodes`` from the
+    scene's ``roots``, its buffer written to ``buffer_file`` and named by ``uri``; and the
+    buffer's bytes."""
+    vertices = np.array([[-1, 0, -1], [1, 0, -1], [0, 0, 1], [-1, 2, -1], [1, 2, -1], [0, 2, 1]], dtype="<f4")
+    indices = np.array([0, 2, 1, 3, 4, 5], dtype="<u2")
+    data = vertices.tobytes() + indices.tobytes()
+    buffer_file.write_bytes(data)
+    document = {
+        "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": roots}], "nodes": nodes,
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}],
+        "materials": [{"name": "panel", "pbrMetallicRoughness": {"metallicFactor": 0}}],
+        "buffers": [{"uri": uri, "byteLength": len(data)}],
+        "bufferViews": [{"buffer": 0, "byteLength": 72}, {"buffer": 0, "byteOffset": 72, "byteLength": 12}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 6, "type": "VEC3"},
+                      {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"}],
+    }
+    return document, data
+
+
 def test_a_gltf_file_loads_pickles_and_renders(tmp_path):
     # A .gltf with its buffer beside it, as numpy writes one: its materials by name for emission,
     # the same bits after a pickle (which reloads the file), and a cut buffer named in the error.
     import json
 
-    vertices = np.array([[-1, 0, -1], [1, 0, -1], [0, 0, 1], [-1, 2, -1], [1, 2, -1], [0, 2, 1]], dtype="<f4")
-    indices = np.array([0, 2, 1, 3, 4, 5], dtype="<u2")
-    data = vertices.tobytes() + indices.tobytes()
-    (tmp_path / "two data.bin").write_bytes(data)
-    document = {
-        "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
-        "nodes": [{"mesh": 0, "translation": [0, 0.5, 0]}],
-        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}],
-        "materials": [{"name": "panel", "pbrMetallicRoughness": {"metallicFactor": 0}}],
-        "buffers": [{"uri": "two%20data.bin", "byteLength": len(data)}],
-        "bufferViews": [{"buffer": 0, "byteLength": 72}, {"buffer": 0, "byteOffset": 72, "byteLength": 12}],
-        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 6, "type": "VEC3"},
-                      {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"}],
-    }
+    nodes = [{"mesh": 0, "translation": [0, 0.5, 0]}]
+    document, data = two_panels_gltf(tmp_path / "two data.bin", "two%20data.bin", nodes, [0])
     path = tmp_path / "two.gltf"
     path.write_text(json.dumps(document))
     scene = lumiere.load(path, emission={"panel": (1, 1, 1)})
@@ -179,27 +187,16 @@ def test_a_gltf_file_loads_pickles_and_renders(tmp_path):
     with pytest.raises(lumiere.LumiereError, match=r"two\.gltf: buffer 0: declares 84 bytes, but its data has 81"):
         lumiere.load(path)
 
+
 def test_a_gltf_camera_is_the_default_view(tmp_path):
     # A camera node (half a turn about +Y, so looking down +Z) is the scene's view: render with
     # camera=None draws what Camera.look_at of that view draws, bit for bit, and a Camera made of
     # it pickles as a look-at. A file without a camera has no view, and renders framed.
     import json
 
-    vertices = np.array([[-1, 0, -1], [1, 0, -1], [0, 0, 1], [-1, 2, -1], [1, 2, -1], [0, 2, 1]], dtype="<f4")
-    indices = np.array([0, 2, 1, 3, 4, 5], dtype="<u2")
-    data = vertices.tobytes() + indices.tobytes()
-    (tmp_path / "data.bin").write_bytes(data)
-    document = {
-        "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1]}],
-        "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0.5, 1.5, -4], "rotation": [0, 1, 0, 0]}],
-        "cameras": [{"name": "Main", "type": "perspective", "perspective": {"yfov": 0.7, "znear": 0.1}}],
-        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}],
-        "materials": [{"name": "panel", "pbrMetallicRoughness": {"metallicFactor": 0}}],
-        "buffers": [{"uri": "data.bin", "byteLength": len(data)}],
-        "bufferViews": [{"buffer": 0, "byteLength": 72}, {"buffer": 0, "byteOffset": 72, "byteLength": 12}],
-        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 6, "type": "VEC3"},
-                      {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"}],
-    }
+    nodes = [{"mesh": 0}, {"camera": 0, "translation": [0.5, 1.5, -4], "rotation": [0, 1, 0, 0]}]
+    document, _ = two_panels_gltf(tmp_path / "data.bin", "data.bin", nodes, [0, 1])
+    document["cameras"] = [{"name": "Main", "type": "perspective", "perspective": {"yfov": 0.7, "znear": 0.1}}]
     with_camera = tmp_path / "camera.gltf"
     with_camera.write_text(json.dumps(document))
     del document["cameras"]
