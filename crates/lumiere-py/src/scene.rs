@@ -187,6 +187,9 @@ impl PyScene {
             entry.set_item("texture_placement", placement(py, material.map_kd_transform)?)?;
             entry.set_item("cutout", material.cutout_mask().map(|p| p.display().to_string()))?;
             entry.set_item("cutout_placement", placement(py, material.map_d_transform)?)?;
+            for (key, map) in [("metallic_texture", &material.map_pm), ("roughness_texture", &material.map_pr)] {
+                entry.set_item(key, map.as_ref().map(|map| map.path.display().to_string()))?;
+            }
             entry.set_item("light", material.is_emissive())?;
             materials.set_item(&material.name, entry)?;
         }

@@ -35,7 +35,9 @@ pub fn run(args: &InfoArgs) -> Result<()> {
         output::warn(warning);
     }
     let (map_kd, map_d) = (materials.iter().map(|m| m.map_kd.as_deref()), materials.iter().map(Material::cutout_mask));
-    for warning in TextureSet::unreadable_files(map_kd, map_d, &scene.embedded_images) {
+    let parameter_maps =
+        materials.iter().flat_map(|m| [&m.map_pm, &m.map_pr]).map(|map| map.as_ref().map(|map| map.path.as_path()));
+    for warning in TextureSet::unreadable_files(map_kd, map_d, parameter_maps, &scene.embedded_images) {
         output::warn(warning);
     }
     let lights = LightSet::new(&scene);
@@ -77,7 +79,8 @@ fn line(key: &str, value: impl Display) -> Result<()> {
 }
 
 /// What lumiere uses of a material: the scattering its statements map to (docs/MATERIALS.md), its
-/// colour, its texture, its cutout mask, its emission.
+/// colour, its texture, the maps that paint its metallic weight and roughness, its cutout mask,
+/// its emission.
 fn describe(material: &Material) -> String {
     let kind = material.kind();
     let details = match kind {
@@ -97,6 +100,13 @@ fn describe(material: &Material) -> String {
         parts.push(format!("Kd {}", vector(material.kd)));
         if let Some(texture) = &material.map_kd {
             parts.push(format!("map_Kd {}{:?}", placement(material.map_kd_transform), texture.display().to_string()));
+        }
+    }
+    for (keyword, map) in [("map_Pm", &material.map_pm), ("map_Pr", &material.map_pr)] {
+        if let Some(map) = map {
+            let channel = format!("{:?}", map.channel).to_lowercase();
+            let path = map.path.display().to_string();
+            parts.push(format!("{keyword} {}{path:?} ({channel} x {})", placement(map.transform), number(map.scale)));
         }
     }
     let test = material.map_d_test;

@@ -311,14 +311,17 @@ fn a_ply_scene_renders_as_its_obj_twin() {
 
 /// A GLB file (its texture embedded) renders as the OBJ file of the same quad and light with the
 /// same PBR statements and a texture file does, byte for byte, path-traced: the same triangles,
-/// materials, texture coordinates and texels.
+/// materials, texture coordinates and texels, the same cutouts, and the same metallic weight and
+/// roughness painted by the texture (glTF's `metallicRoughnessTexture`, MTL's `map_Pm` and
+/// `map_Pr` reading its blue and green channels).
 #[test]
 fn a_glb_scene_renders_as_its_obj_twin() {
     let dir = TempDir::new("gltf-twin");
-    // The texture: colours, and an alpha that cuts holes (MTL's `map_d`, glTF's `alphaMode MASK`)
-    // on both sides of one half.
+    // The texture: colours, a roughness (green) and a metallic weight (blue) on both sides of one
+    // half, and an alpha that cuts holes (MTL's `map_d`, glTF's `alphaMode MASK`) on both sides of
+    // one half.
     let texels: Vec<u8> =
-        (0..16u8).flat_map(|i| [i * 16, 255 - i * 8, 60 + i, [0, 255, 127, 128][i as usize % 4]]).collect();
+        (0..16u8).flat_map(|i| [i * 16, 255 - i * 8, 255 - i * 16, [0, 255, 127, 128][i as usize % 4]]).collect();
     let mut png = std::io::Cursor::new(Vec::new());
     image::RgbaImage::from_raw(4, 4, texels).unwrap().write_to(&mut png, image::ImageFormat::Png).unwrap();
     let png = png.into_inner();
@@ -342,11 +345,13 @@ fn a_glb_scene_renders_as_its_obj_twin() {
         obj += &format!("vt {u} {v}\n");
     }
     obj += "usemtl floor\nf 1/1 2/2 3/3 4/4\nusemtl lamp\nf 5 6 7\n";
-    dir.write("twin.obj", obj);
-    dir.write(
-        "twin.mtl",
-        "newmtl floor\nKd 1 1 1\nPm 0\nPr 0.5\nmap_Kd tex.png\nmap_d tex.png\nnewmtl lamp\nKd 0 0 0\nKe 5 5 5\nPm 0\nPr 1\n",
-    );
+    dir.write("twin.obj", &obj);
+    let mtl = "newmtl floor\nKd 1 1 1\nPm 0\nPr 0.5\nmap_Kd tex.png\nmap_d tex.png\n\
+               map_Pm -imfchan b tex.png\nmap_Pr -imfchan g tex.png\nnewmtl lamp\nKd 0 0 0\nKe 5 5 5\nPm 0\nPr 1\n";
+    dir.write("twin.mtl", mtl);
+    // The same without the maps: the twins must differ from it for the maps to be tested.
+    dir.write("plain.mtl", mtl.replace("map_Pm -imfchan b tex.png\nmap_Pr -imfchan g tex.png\n", ""));
+    dir.write("plain.obj", obj.replace("twin.mtl", "plain.mtl"));
     let mut bin: Vec<u8> = corners.iter().flatten().flat_map(|c| c.to_le_bytes()).collect();
     bin.extend(uv.iter().flat_map(|[u, v]| [*u, 1.0 - v]).flat_map(|c| c.to_le_bytes()));
     bin.extend([0u16, 1, 2, 0, 2, 3, 0, 1, 2].iter().flat_map(|i| i.to_le_bytes()));
@@ -362,7 +367,7 @@ fn a_glb_scene_renders_as_its_obj_twin() {
             {{"attributes": {{"POSITION": 0, "TEXCOORD_0": 1}}, "indices": 2, "material": 0}},
             {{"attributes": {{"POSITION": 3}}, "indices": 4, "material": 1}}]}}],
         "materials": [
-            {{"name": "floor", "alphaMode": "MASK", "pbrMetallicRoughness": {{"metallicFactor": 0, "roughnessFactor": 0.5, "baseColorTexture": {{"index": 0}}}}}},
+            {{"name": "floor", "alphaMode": "MASK", "pbrMetallicRoughness": {{"baseColorTexture": {{"index": 0}}, "metallicRoughnessTexture": {{"index": 0}}}}}},
             {{"name": "lamp", "pbrMetallicRoughness": {{"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0}}, "emissiveFactor": [1, 1, 1],
               "extensions": {{"KHR_materials_emissive_strength": {{"emissiveStrength": 5}}}}}}],
         "extensionsUsed": ["KHR_materials_emissive_strength"],
@@ -395,7 +400,7 @@ fn a_glb_scene_renders_as_its_obj_twin() {
     glb.extend(&bin);
     dir.write("twin.glb", glb);
     let mut images = Vec::new();
-    for name in ["twin.obj", "twin.glb"] {
+    for name in ["twin.obj", "twin.glb", "plain.obj"] {
         let scene = dir.path(name);
         let out = dir.arg(&format!("{name}.pfm"));
         let args = [
@@ -418,6 +423,7 @@ fn a_glb_scene_renders_as_its_obj_twin() {
         images.push(fs::read(&out).unwrap());
     }
     assert!(images[0] == images[1], "the GLB's image differs from the OBJ's");
+    assert!(images[0] != images[2], "the maps change nothing");
     // Cut short inside its binary chunk: refused, naming the file and the chunk.
     let cut = dir.write("cut.glb", &fs::read(dir.path("twin.glb")).unwrap()[..200]);
     assert_refused(&dir, &["render", cut.to_str().unwrap()], "cut.glb: GLB: the header gives a length of");

@@ -11,6 +11,7 @@ use super::microfacet::MIN_ALPHA;
 use super::{Conductor, Dielectric, Lambert, MaterialBsdf, Mirror, Plastic};
 use crate::error::shown_name;
 use crate::math::UvTransform;
+use crate::textures::Channel;
 use std::path::{Path, PathBuf};
 
 /// The index of refraction of a transmissive material whose file gives none usable (ordinary
@@ -71,6 +72,27 @@ pub struct Material {
     /// Perceptual roughness (MTL PBR extension `Pr`, 0–1); GGX `α = Pr²`. `None` when the file
     /// does not say.
     pub roughness: Option<f32>,
+    /// Metallic weight painted by a texture (MTL `map_Pm`, glTF's `metallicRoughnessTexture`'s
+    /// blue channel): where it decodes, its value at the hit replaces `metallic`.
+    pub map_pm: Option<ParameterMap>,
+    /// Perceptual roughness painted by a texture (MTL `map_Pr`, glTF's
+    /// `metallicRoughnessTexture`'s green channel): where it decodes, its value at the hit
+    /// replaces `roughness`.
+    pub map_pr: Option<ParameterMap>,
+}
+
+/// A material parameter painted by a texture: one channel of the values its file stores (data,
+/// not a colour: no sRGB decoding), bilinearly filtered, times `scale`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParameterMap {
+    /// Resolved relative to the MTL file, or the name of an image the scene file embeds.
+    pub path: PathBuf,
+    /// Where the texture lies on the surface (`-s`, `-o`, or glTF's `KHR_texture_transform`).
+    pub transform: UvTransform,
+    pub channel: Channel,
+    /// What the texture's value is multiplied by: glTF's `metallicFactor` or `roughnessFactor`;
+    /// 1 for MTL, whose map replaces the value, as `map_Kd` replaces `Kd`.
+    pub scale: f32,
 }
 
 /// Where a coverage texture keeps its surface: the coverage (the texture's bilinearly filtered
@@ -144,6 +166,20 @@ pub enum MaterialKind {
 }
 
 impl MaterialKind {
+    /// The PBR extension's kind: a metal ([`MaterialKind::Conductor`], base colour = `F0`) of GGX
+    /// roughness `alpha` when `metallic ≥ 0.5`, otherwise a plastic with a 4% specular layer (the
+    /// PBR dielectric). A threshold, not a blend: scanned materials are metal or not, and values
+    /// in between come from filtered metallic maps at the borders of metal parts (a NaN is not
+    /// metal).
+    #[inline]
+    pub fn pbr(metallic: f32, alpha: f32) -> MaterialKind {
+        if metallic >= 0.5 {
+            MaterialKind::Conductor { alpha }
+        } else {
+            MaterialKind::Plastic { ks: Vec3::splat(PBR_DIELECTRIC_SPECULAR), alpha }
+        }
+    }
+
     /// The BSDF of this kind with `base_colour` (the material's `kd`, or its texture's value at the
     /// hit) as diffuse colour or metal `F0`.
     #[inline]
@@ -169,6 +205,13 @@ impl MaterialKind {
             MaterialKind::Dielectric { .. } => "dielectric",
         }
     }
+}
+
+/// GGX `α` from a perceptual roughness (`Pr`, glTF's `roughness`): its square, the roughness
+/// clamped to [0, 1] first; a NaN (a texture's 0 times an infinite factor) gives 1, the roughest.
+#[inline]
+pub fn pbr_alpha(roughness: f32) -> f32 {
+    if roughness.is_nan() { 1.0 } else { roughness.clamp(0.0, 1.0).powi(2) }
 }
 
 /// The GGX roughness equivalent to a Blinn–Phong exponent: `α = √(2 / (Ns + 2))`, the
@@ -201,6 +244,8 @@ impl Material {
             tf: Vec3::ONE,
             metallic: None,
             roughness: None,
+            map_pm: None,
+            map_pr: None,
         }
     }
 
@@ -237,11 +282,10 @@ impl Material {
     /// The one mapping from a material's statements to its kind of scattering, in this order
     /// (the first rule that applies wins; docs/MATERIALS.md has the table and the reasons):
     ///
-    /// 1. **PBR extension** (`Pm` or `Pr` given): `α = Pr²` (or from `Ns` without `Pr`); a metal
-    ///    ([`MaterialKind::Conductor`], base colour = `F0`) when `Pm ≥ 0.5`, otherwise a plastic
-    ///    with a 4% specular layer (the PBR dielectric). A threshold, not a blend: scanned
-    ///    materials are metal or not, and values in between come from filtered metallic maps,
-    ///    which MTL files do not carry here.
+    /// 1. **PBR extension** (`Pm`, `Pr`, `map_Pm` or `map_Pr` given): [`MaterialKind::pbr`] of
+    ///    `Pm` (0 without) and `Pr` (see [`Material::pbr_alpha`]). Where a map paints either,
+    ///    the kind at each hit is that of the map's value there ([`MaterialKind::pbr`] again);
+    ///    this is the kind without the maps.
     /// 2. **Glass** ([`MaterialKind::Dielectric`]): `illum` 4, 6, 7 or 9 (the transmissive
     ///    illumination models), or `d < 1` with an explicit `Ni` (≠ 1); index `Ni`, or
     ///    [`DEFAULT_IOR`] when absent, 1 or outside the format's range; filter `Tf`.
@@ -254,16 +298,8 @@ impl Material {
     ///    a glossy paint keeps its colour.
     /// 5. **Plastic**: `Kd` under a GGX layer of `Ks`, `α =` [`alpha_from_ns`]`(Ns)`.
     pub fn kind(&self) -> MaterialKind {
-        if self.metallic.is_some() || self.roughness.is_some() {
-            let alpha = match self.roughness {
-                Some(pr) if !pr.is_nan() => pr.clamp(0.0, 1.0).powi(2),
-                _ => alpha_from_ns(self.ns),
-            };
-            return if self.metallic.is_some_and(|pm| pm >= 0.5) {
-                MaterialKind::Conductor { alpha }
-            } else {
-                MaterialKind::Plastic { ks: Vec3::splat(PBR_DIELECTRIC_SPECULAR), alpha }
-            };
+        if self.is_pbr() {
+            return MaterialKind::pbr(self.metallic.unwrap_or(0.0), self.pbr_alpha());
         }
         let explicit_ior = IOR_RANGE.contains(&self.ni) && self.ni != 1.0;
         if matches!(self.illum, 4 | 6 | 7 | 9) || (self.dissolve < 1.0 && explicit_ior) {
@@ -283,6 +319,20 @@ impl Material {
             };
         }
         MaterialKind::Plastic { ks, alpha: alpha_from_ns(self.ns) }
+    }
+
+    /// Whether the PBR extension's rule decides the kind (rule 1 of [`Material::kind`]).
+    pub fn is_pbr(&self) -> bool {
+        self.metallic.is_some() || self.roughness.is_some() || self.map_pm.is_some() || self.map_pr.is_some()
+    }
+
+    /// The GGX roughness of a PBR material without a roughness map: `Pr²`, or from `Ns` without
+    /// `Pr` (or with a NaN one).
+    pub fn pbr_alpha(&self) -> f32 {
+        match self.roughness {
+            Some(pr) if !pr.is_nan() => pbr_alpha(pr),
+            _ => alpha_from_ns(self.ns),
+        }
     }
 
     /// The scattering function of this material at a point whose base colour is `base_colour`:

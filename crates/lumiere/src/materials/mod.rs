@@ -26,7 +26,9 @@ use glam::{Vec2, Vec3};
 pub use conductor::{Conductor, Mirror};
 pub use dielectric::Dielectric;
 pub use lambert::Lambert;
-pub use material::{CoverageTest, Cut, DEFAULT_IOR, Material, MaterialKind, SMOOTH_NS, alpha_from_ns};
+pub use material::{
+    CoverageTest, Cut, DEFAULT_IOR, Material, MaterialKind, ParameterMap, SMOOTH_NS, alpha_from_ns, pbr_alpha,
+};
 pub use plastic::Plastic;
 
 /// What kind of scattering a sample took; integrators use it to skip light sampling where it

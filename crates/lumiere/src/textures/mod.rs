@@ -97,20 +97,32 @@ impl Texels {
         }
     }
 
-    /// Texel `i` read as a scalar (a coverage mask without an alpha channel): the luminance of the
-    /// values the file stores, without sRGB decoding (a mask is not a colour). 8-bit codes are
-    /// kept, over 255; 16-bit texels were decoded when loaded, and the encoding curve gives their
-    /// file values back (to within rounding), so that a mask reads the same at either depth.
+    /// The values the file stores for texel `i`, without sRGB decoding: data such as a mask or a
+    /// roughness is not a colour. 8-bit codes are kept, over 255; 16-bit texels were decoded when
+    /// loaded, and the encoding curve gives their file values back (to within rounding), so that
+    /// data reads the same at either depth.
     #[inline]
-    fn scalar(&self, i: usize) -> f32 {
-        let stored = match self {
+    fn stored(&self, i: usize) -> Vec3 {
+        match self {
             Texels::Srgb8 { codes, .. } => {
                 let [r, g, b, _] = codes[i];
                 Vec3::new(r.into(), g.into(), b.into()) / 255.0
             }
             Texels::Linear(rgb) => rgb[i].to_array().map(linear_to_srgb).into(),
-        };
-        stored.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+        }
+    }
+
+    /// Texel `i` read as a scalar through `channel`: one of its [`Texels::stored`] values, or
+    /// their luminance (a coverage mask without an alpha channel).
+    #[inline]
+    fn scalar(&self, i: usize, channel: Channel) -> f32 {
+        let stored = self.stored(i);
+        match channel {
+            Channel::Red => stored.x,
+            Channel::Green => stored.y,
+            Channel::Blue => stored.z,
+            Channel::Luminance => stored.dot(Vec3::new(0.2126, 0.7152, 0.0722)),
+        }
     }
 
     fn memory_bytes(&self) -> usize {
@@ -240,7 +252,14 @@ impl Texture {
         if self.alpha.is_some() {
             return self.sample_alpha(uv);
         }
-        self.footprint(uv).iter().map(|&(i, w)| self.rgb.scalar(i) * w).sum()
+        self.sample_channel(uv, Channel::Luminance)
+    }
+
+    /// The bilinearly filtered value of `channel` at `uv`, read from the values the file stores
+    /// (not decoded from sRGB): a material parameter painted by the texture, such as a roughness.
+    #[inline]
+    pub fn sample_channel(&self, uv: Vec2, channel: Channel) -> f32 {
+        self.footprint(uv).iter().map(|&(i, w)| self.rgb.scalar(i, channel) * w).sum()
     }
 
     /// The four texels around `uv` and their bilinear weights (which sum to 1).
@@ -395,6 +414,18 @@ fn srgb_table() -> &'static [f32; 256] {
     TABLE.get_or_init(|| std::array::from_fn(|code| srgb_to_linear(code as f32 / 255.0)))
 }
 
+/// Which of a texture's channels a scalar lookup reads ([`Texture::sample_channel`]; MTL's
+/// `-imfchan r|g|b|l`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Channel {
+    Red,
+    Green,
+    Blue,
+    /// The luminance of the stored red, green and blue: a grey image's level (MTL's default for
+    /// scalar maps).
+    Luminance,
+}
+
 /// Names one texture of a [`TextureSet`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct TextureId(u32);
@@ -499,20 +530,33 @@ impl TextureSet {
         TextureSet::per_material(map_d, WITHOUT_COVERAGE, embedded)
     }
 
-    /// The warnings [`TextureSet::for_materials`] and [`TextureSet::for_cutouts`] would give
-    /// for the files among `map_kd` and `map_d` that are missing, not regular files or too
-    /// large: the checks that need no decoding, so they cost no more than a file's metadata
-    /// (what `lumiere info` shows). Images `embedded` in the scene file are not files: they are
-    /// checked when they are decoded.
+    /// As [`TextureSet::for_materials`], for the textures that paint material parameters
+    /// (`map_Pm`, `map_Pr`, glTF's `metallicRoughnessTexture`): a file that fails leaves its
+    /// material its constant values.
+    pub fn for_parameters<'a>(
+        maps: impl IntoIterator<Item = Option<&'a Path>>,
+        embedded: &EmbeddedImages,
+    ) -> (Vec<Option<TextureId>>, TextureSet, Vec<String>) {
+        TextureSet::per_material(maps, WITHOUT_PARAMETER, embedded)
+    }
+
+    /// The warnings [`TextureSet::for_materials`], [`TextureSet::for_cutouts`] and
+    /// [`TextureSet::for_parameters`] would give for the files among `map_kd`, `map_d` and
+    /// `parameter_maps` that are missing, not regular files or too large: the checks that need no
+    /// decoding, so they cost no more than a file's metadata (what `lumiere info` shows). Images
+    /// `embedded` in the scene file are not files: they are checked when they are decoded.
     pub fn unreadable_files<'a>(
         map_kd: impl IntoIterator<Item = Option<&'a Path>>,
         map_d: impl IntoIterator<Item = Option<&'a Path>>,
+        parameter_maps: impl IntoIterator<Item = Option<&'a Path>>,
         embedded: &EmbeddedImages,
     ) -> Vec<String> {
         let mut warnings = Vec::new();
-        for (paths, instead) in
-            [(map_kd.into_iter().collect::<Vec<_>>(), WITHOUT_DIFFUSE), (map_d.into_iter().collect(), WITHOUT_COVERAGE)]
-        {
+        for (paths, instead) in [
+            (map_kd.into_iter().collect::<Vec<_>>(), WITHOUT_DIFFUSE),
+            (map_d.into_iter().collect(), WITHOUT_COVERAGE),
+            (parameter_maps.into_iter().collect(), WITHOUT_PARAMETER),
+        ] {
             let mut seen: Vec<&Path> = Vec::new();
             for path in paths.into_iter().flatten() {
                 if seen.contains(&path) || embedded.contains(path) {
@@ -583,10 +627,11 @@ impl TextureSet {
     }
 }
 
-/// What a material does without its diffuse texture, or without its coverage texture: the end
-/// of each warning about a file that cannot be used.
+/// What a material does without its diffuse texture, its coverage texture, or a texture that
+/// paints its parameters: the end of each warning about a file that cannot be used.
 const WITHOUT_DIFFUSE: &str = "the material's Kd is used instead";
 const WITHOUT_COVERAGE: &str = "the material stays opaque";
+const WITHOUT_PARAMETER: &str = "the material's metallic and roughness values are used instead";
 
 /// The warning about texture file `path`: quoted and escaped like a string literal (not cut: the
 /// user must find the file), so that a control character from the MTL file cannot garble the line.

@@ -6,12 +6,13 @@
 use crate::common::TempDir;
 use base64::Engine;
 use glam::{Vec2, Vec3};
-use lumiere::materials::{CoverageTest, Cut, MaterialKind};
+use lumiere::materials::{Bsdf, CoverageTest, Cut, MaterialBsdf, MaterialKind, pbr_alpha};
 use lumiere::math::Ray;
 use lumiere::scene::Scene;
 use lumiere::scene::load::gltf::{DEFAULT_NAME, parse_gltf, parse_gltf_with_memory};
 use lumiere::scene::load::load;
 use lumiere::scene::load::obj::parse_obj;
+use lumiere::textures::Channel;
 use lumiere::util::hash::hash_bytes;
 use std::io;
 use std::path::{Path, PathBuf};
@@ -478,6 +479,77 @@ fn alpha_mask_materials_cut_their_surface_where_the_base_colour_alpha_is_below_t
     }
 }
 
+/// Asserts that `actual` scatters as `expected` does: the same lobe, and the same `f` for a few
+/// pairs of directions, to within the rounding of the texture lookup's weights.
+fn assert_scatters_as(actual: MaterialBsdf, expected: MaterialBsdf, what: &str) {
+    assert_eq!(std::mem::discriminant(&actual), std::mem::discriminant(&expected), "{what}: {actual:?}");
+    let wo = Vec3::new(0.3, -0.2, 0.9).normalize();
+    for wi in [Vec3::new(-0.3, 0.2, 0.9), Vec3::new(0.1, 0.5, 0.6), Vec3::Z].map(Vec3::normalize) {
+        let (a, e) = (actual.eval(wo, wi), expected.eval(wo, wi));
+        assert!((a - e).abs().max_element() <= 1e-4 * e.max_element().max(1.0), "{what}: f {a} vs {e}");
+    }
+}
+
+/// A `metallicRoughnessTexture` paints its material's kind: at each hit, the blue channel times
+/// `metallicFactor` makes it a metal from one half up, and the green times `roughnessFactor` is
+/// its roughness (GGX `α` its square), read as data (not sRGB-decoded); under transmission the
+/// glass ignores it, and a texture that does not decode leaves the factors.
+#[test]
+fn metallic_roughness_textures_paint_the_kind_at_each_hit() {
+    let mut builder = Builder::default();
+    let primitive = quad(&mut builder);
+    // Left texel: metal, roughness 0.2; right texel: not metal, roughness 0.8.
+    let orm =
+        builder.view(&encoded(image::RgbImage::from_raw(2, 1, vec![0, 51, 255, 0, 204, 0]).unwrap().into()), None);
+    let broken = builder.view(b"\x89PNG not an image", None);
+    let materials = [
+        r#"{"name": "painted", "pbrMetallicRoughness": {"metallicRoughnessTexture": {"index": 0}}}"#,
+        r#"{"name": "scaled", "pbrMetallicRoughness": {"metallicFactor": 0.4, "roughnessFactor": 0.5, "metallicRoughnessTexture": {"index": 0}}}"#,
+        r#"{"name": "glass", "pbrMetallicRoughness": {"roughnessFactor": 0, "metallicRoughnessTexture": {"index": 0}},
+           "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1}}}"#,
+        r#"{"name": "broken", "pbrMetallicRoughness": {"roughnessFactor": 0.3, "metallicRoughnessTexture": {"index": 1}}}"#,
+    ];
+    let images = format!(
+        r#""images": [{{"bufferView": {orm}, "mimeType": "image/png"}}, {{"bufferView": {broken}, "mimeType": "image/png"}}],
+        "textures": [{{"source": 0}}, {{"source": 1}}], "extensionsUsed": ["KHR_materials_transmission"]"#
+    );
+    let scene = parse(&builder.gltf(&quad_per_material(&primitive, &materials, &images)));
+    let painted = &scene.materials[0];
+    let (metallic, rough) = (painted.map_pm.as_ref().unwrap(), painted.map_pr.as_ref().unwrap());
+    assert_eq!(
+        (metallic.channel, metallic.scale, rough.channel, rough.scale),
+        (Channel::Blue, 1.0, Channel::Green, 1.0)
+    );
+    assert_eq!(metallic.path, rough.path, "one texture, two channels");
+    assert_eq!(scene.materials[2].map_pr, None, "glass is smooth");
+    assert_eq!(
+        scene.warnings,
+        ["test.gltf: material 'glass': not read: metallicRoughnessTexture under transmission (the glass is smooth)"]
+    );
+    let world = lumiere::world::World::new(scene, lumiere::accel::BuildPreset::Default);
+    assert_eq!(world.warnings().len(), 1, "{:?}", world.warnings());
+    assert!(
+        world.warnings()[0].contains("#image1")
+            && world.warnings()[0].ends_with("metallic and roughness values are used instead")
+    );
+    let pbr = |metallic: f32, roughness: f32| MaterialKind::pbr(metallic, pbr_alpha(roughness)).bsdf(Vec3::ONE);
+    let (low, high) = (51.0 / 255.0, 204.0 / 255.0);
+    let expected = [
+        [pbr(1.0, low), pbr(0.0, high)],
+        [pbr(0.4, 0.5 * low), pbr(0.0, 0.5 * high)],
+        [MaterialKind::Dielectric { eta: 1.5, tf: Vec3::ONE }.bsdf(Vec3::ONE); 2],
+        [pbr(1.0, 0.3); 2],
+    ];
+    for (m, expected) in expected.into_iter().enumerate() {
+        for (x, expected) in [0.25, 0.75].into_iter().zip(expected) {
+            let ray = Ray::new(Vec3::new(2.0 * m as f32 + x, 0.5, 1.0), -Vec3::Z);
+            let hit = world.intersect(&ray).unwrap();
+            let surface = world.surface(&ray, &hit);
+            assert_scatters_as(world.bsdf(&surface), expected, &format!("material {m} at x = {x}"));
+        }
+    }
+}
+
 /// The share of `rays` that `world` lets through.
 fn share_through(world: &lumiere::world::World, rays: impl Iterator<Item = Ray>) -> f64 {
     let (mut through, mut count) = (0, 0);
@@ -583,7 +655,11 @@ fn base_colour_textures_are_found_beside_the_file_or_embedded_and_placed() {
     let world = lumiere::world::World::new(scene, lumiere::accel::BuildPreset::Default);
     assert!(world.warnings().is_empty(), "{:?}", world.warnings());
     for material in 0..3 {
-        assert_eq!(world.texture_contents(material), [Some(hash_bytes(&png())), None], "material {material}");
+        assert_eq!(
+            world.texture_contents(material),
+            [Some(hash_bytes(&png())), None, None, None],
+            "material {material}"
+        );
     }
 }
 

@@ -14,7 +14,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ("sampler", &["util"]),
     ("textures", &["error", "math", "util"]),
     ("geometry", &["math"]),
-    ("materials", &["error", "math", "sampling"]),
+    ("materials", &["error", "math", "sampling", "textures"]),
     ("accel", &["geometry", "math"]),
     ("scene", &["error", "materials", "math", "textures", "util"]),
     ("lights", &["geometry", "math", "sampling", "scene", "util"]),

@@ -5,9 +5,11 @@ use crate::common::TempDir;
 use flate2::Compression;
 use flate2::write::GzEncoder;
 use glam::{Vec2, Vec3};
+use lumiere::materials::{MaterialKind, ParameterMap};
 use lumiere::math::UvTransform;
 use lumiere::scene::load::obj::{ObjScene, load_obj, parse_obj, parse_obj_with_chunk_size};
 use lumiere::scene::mesh::NO_INDEX;
+use lumiere::textures::Channel;
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -515,6 +517,41 @@ fn texture_options_and_file_names_with_spaces() {
         "mem/t.mtl: material \"odd\" uses statements lumiere does not render: \"map_d -foo\", \"map_d -mm\", \"map_d -bm\" (see docs/MATERIALS.md)",
     ];
     assert_eq!(scene.warnings, expected);
+}
+
+/// `map_Pm` and `map_Pr` (the PBR extension's maps, as tinyobjloader reads them) paint a
+/// material's metallic weight and roughness: the file with its placement, the channel
+/// `-imfchan` chooses (`r`, `g`, `b` or `l`, the luminance, by default), replacing the constant;
+/// a channel lumiere does not read is named, and the luminance read.
+#[test]
+fn metallic_and_roughness_maps_read_their_channel_and_placement() {
+    let mtl = "newmtl orm\nPm 0\nPr 0.5\nmap_Pm -imfchan B orm.png\nmap_Pr -s 2 2 -imfchan g orm.png\n\
+               newmtl grey\nmap_Pr rough ness.png\n\
+               newmtl matte\nKd 1 1 1\nmap_Pm -imfchan m metal.png\n";
+    let scene = parse_with(&format!("mtllib t.mtl\n{SQUARE}usemtl orm\nf 1 2 3\n"), &[("t.mtl", mtl)]);
+    let [orm, grey, matte] = &scene.materials[..] else { panic!("{:?}", scene.materials) };
+    let map = |file: &str, scale: f32, channel| ParameterMap {
+        path: PathBuf::from(format!("mem/{file}")),
+        transform: UvTransform { scale: Vec2::splat(scale), offset: Vec2::ZERO },
+        channel,
+        scale: 1.0,
+    };
+    assert_eq!(orm.map_pm, Some(map("orm.png", 1.0, Channel::Blue)));
+    assert_eq!(orm.map_pr, Some(map("orm.png", 2.0, Channel::Green)));
+    assert_eq!(
+        (grey.map_pm.as_ref(), grey.map_pr.as_ref()),
+        (None, Some(&map("rough ness.png", 1.0, Channel::Luminance)))
+    );
+    assert_eq!(matte.map_pm, Some(map("metal.png", 1.0, Channel::Luminance)));
+    // A map alone makes the material PBR: a plastic where the map does not paint it metal.
+    assert_eq!(grey.kind(), MaterialKind::Plastic { ks: Vec3::splat(0.04), alpha: 1.0 });
+    assert_eq!(matte.kind(), MaterialKind::Plastic { ks: Vec3::splat(0.04), alpha: 1.0 });
+    assert_eq!(
+        scene.warnings,
+        [
+            "mem/t.mtl: material \"matte\" uses statements lumiere does not render: \"map_Pm -imfchan\" (see docs/MATERIALS.md)"
+        ]
+    );
 }
 
 /// MTL names keep their bytes: a Latin-1 name stays apart from its neighbour (each byte read as

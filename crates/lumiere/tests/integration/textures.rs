@@ -462,6 +462,43 @@ fn coverage_is_the_alpha_or_the_stored_grey_at_either_depth() {
     assert!((load_one(&colour).sample_coverage(Vec2::splat(0.5)) - 0.2126).abs() < 1e-6);
 }
 
+/// A texture that paints a parameter (a roughness, a metallic weight) is data: each channel reads
+/// the values the file stores, not sRGB-decoded, the same at 8 and 16 bits, and the luminance
+/// channel reads a grey level as itself.
+#[test]
+fn a_channel_reads_the_stored_values_at_either_depth() {
+    use image::ImageBuffer;
+    use lumiere::textures::Channel;
+    let dir = TempDir::new("textures-channels");
+    let codes = |x: u32| [(x * 50) as u8, 255 - (x * 40) as u8, [5, 128, 200, 0][x as usize]];
+    let eight = dir.path("eight.png");
+    RgbImage::from_fn(4, 1, |x, _| Rgb(codes(x))).save_with_format(&eight, ImageFormat::Png).unwrap();
+    let sixteen = dir.path("sixteen.png");
+    ImageBuffer::from_fn(4, 1, |x, _| Rgb(codes(x).map(|c| u16::from(c) * 257)))
+        .save_with_format(&sixteen, ImageFormat::Png)
+        .unwrap();
+    for path in [&eight, &sixteen] {
+        let texture = load_one(path);
+        for x in 0..4 {
+            let stored = codes(x).map(|c| f32::from(c) / 255.0);
+            let luminance = 0.2126 * stored[0] + 0.7152 * stored[1] + 0.0722 * stored[2];
+            for (channel, expected) in [
+                (Channel::Red, stored[0]),
+                (Channel::Green, stored[1]),
+                (Channel::Blue, stored[2]),
+                (Channel::Luminance, luminance),
+            ] {
+                let value = texture.sample_channel(centre(x, 0, 4, 1), channel);
+                assert!(
+                    (value - expected).abs() < 1e-4,
+                    "{}: texel {x} {channel:?}: {value} vs {expected}",
+                    path.display()
+                );
+            }
+        }
+    }
+}
+
 /// A diffuse texture's `-s` and `-o` (MTL) move where the surface reads it, through everything
 /// that shades (`World::lambert_reflectance` and `World::bsdf` share the lookup): `uv · s + o`.
 #[test]
@@ -628,5 +665,41 @@ fn the_scene_fingerprint_holds_how_a_mask_cuts() {
     ];
     for (i, a) in tests.iter().enumerate() {
         assert!(tests[i + 1..].iter().all(|b| a != b), "{tests:x?}");
+    }
+}
+
+/// The maps that paint a material's metallic weight and roughness are part of the scene's
+/// fingerprint: their files' bytes, the channel each reads, its factor and its placement.
+#[test]
+fn the_scene_fingerprint_holds_the_parameter_maps() {
+    use lumiere::textures::Channel;
+    let dir = TempDir::new("fingerprint-parameter-maps");
+    test_image().save_with_format(dir.path("orm.png"), ImageFormat::Png).unwrap();
+    dir.write("m.mtl", "newmtl brass\nPm 1\nPr 0.5\nmap_Pr -imfchan g orm.png\n");
+    let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl brass\nf 1/1 2/2 3/3\n";
+    let scene = dir.write("s.obj", obj);
+    let fingerprint = |edit: &dyn Fn(&mut lumiere::materials::Material)| {
+        let mut scene = Scene::load(&scene).unwrap();
+        edit(&mut scene.materials[0]);
+        scene_fingerprint(&World::new(scene, Default::default()))
+    };
+    let plain = fingerprint(&|_| {});
+    assert_eq!(fingerprint(&|_| {}), plain, "the same files, the same fingerprint");
+    let mut fingerprints = vec![
+        plain,
+        fingerprint(&|m| m.map_pr = None),
+        fingerprint(&|m| m.map_pm = m.map_pr.take()),
+        fingerprint(&|m| m.map_pr.as_mut().unwrap().channel = Channel::Blue),
+        fingerprint(&|m| m.map_pr.as_mut().unwrap().scale = 0.5),
+        fingerprint(&|m| m.map_pr.as_mut().unwrap().transform.offset.x = 0.5),
+    ];
+    let mut edited = test_image();
+    edited.put_pixel(1, 1, Rgb([1, 2, 3]));
+    edited.save_with_format(dir.path("orm.png"), ImageFormat::Png).unwrap();
+    fingerprints.push(fingerprint(&|_| {}));
+    std::fs::remove_file(dir.path("orm.png")).unwrap();
+    fingerprints.push(fingerprint(&|_| {}));
+    for (i, a) in fingerprints.iter().enumerate() {
+        assert!(fingerprints[i + 1..].iter().all(|b| a != b), "{fingerprints:x?}");
     }
 }

@@ -2,15 +2,16 @@
 //! extension's mapping (a metal from `metallic ≥ 0.5`, otherwise a plastic with a 4% layer;
 //! GGX `α = roughness²`), `KHR_materials_transmission` onto smooth glass of `KHR_materials_ior`'s
 //! index, emission from `emissiveFactor` (times `KHR_materials_emissive_strength`), and the base
-//! colour texture with its placement, and `alphaMode` `MASK` and `BLEND` as cutouts by the base
-//! colour's alpha.
+//! colour texture with its placement, the metallic-roughness texture as maps of the two, and
+//! `alphaMode` `MASK` and `BLEND` as cutouts by the base colour's alpha.
 //! What is not honoured is named in one warning per material.
 //! docs/MATERIALS.md has the table.
 
 use crate::error::{shown_name, shown_path};
-use crate::materials::{CoverageTest, Cut, Material};
+use crate::materials::{CoverageTest, Cut, Material, ParameterMap};
 use crate::math::UvTransform;
 use crate::scene::load::warnings::Warnings;
+use crate::textures::Channel;
 use glam::{Vec2, Vec3};
 use std::path::{Path, PathBuf};
 
@@ -25,8 +26,8 @@ const GLASS_FROM_TRANSMISSION: f32 = 0.5;
 /// Finds the file a glTF image is in (or names its embedded bytes); the error is a reason.
 pub(super) type ImagePath<'r> = &'r mut dyn FnMut(&gltf::Image) -> Result<PathBuf, String>;
 
-/// A glTF material as lumiere draws it, the texture coordinate set (`TEXCOORD_n`) its base
-/// colour texture reads, and whether its surface is there at all.
+/// A glTF material as lumiere draws it, the texture coordinate set (`TEXCOORD_n`) its textures
+/// read, and whether its surface is there at all.
 pub(super) struct Converted {
     pub(super) material: Material,
     pub(super) texcoord_set: u32,
@@ -62,7 +63,7 @@ pub(super) fn convert(
     material.roughness = Some(pbr.roughness_factor());
     let mut texcoord_set = 0;
     if let Some(info) = pbr.base_color_texture() {
-        match base_colour_texture(&info, image_path, &mut not_read) {
+        match texture_of(&info, image_path, &mut not_read) {
             Ok((path, transform, set)) => {
                 if material.kd != Vec3::ONE {
                     not_read.push("baseColorFactor under baseColorTexture (the texture is used alone)".to_string());
@@ -80,9 +81,8 @@ pub(super) fn convert(
             }),
         }
     }
-    if let Some(transmission) = source.transmission()
-        && transmission.transmission_factor() >= GLASS_FROM_TRANSMISSION
-    {
+    let glass = source.transmission().filter(|t| t.transmission_factor() >= GLASS_FROM_TRANSMISSION);
+    if let Some(transmission) = glass {
         // Glass: the PBR fields would make it a metal or a plastic (see `Material::kind`).
         (material.metallic, material.roughness) = (None, None);
         material.illum = 7;
@@ -95,8 +95,26 @@ pub(super) fn convert(
         if pbr.roughness_factor() > 0.0 {
             not_read.push("roughness under transmission (the glass is smooth)".to_string());
         }
-    } else if source.ior().is_some_and(|ior| ior != crate::materials::DEFAULT_IOR) {
-        not_read.push("KHR_materials_ior without transmission (the specular layer reflects 4%)".to_string());
+        if pbr.metallic_roughness_texture().is_some() {
+            not_read.push("metallicRoughnessTexture under transmission (the glass is smooth)".to_string());
+        }
+    } else {
+        if source.ior().is_some_and(|ior| ior != crate::materials::DEFAULT_IOR) {
+            not_read.push("KHR_materials_ior without transmission (the specular layer reflects 4%)".to_string());
+        }
+        if let Some(info) = pbr.metallic_roughness_texture() {
+            let base_set = material.map_kd.is_some().then_some(texcoord_set);
+            match metallic_roughness_maps(&mut material, &info, base_set, image_path, &mut not_read) {
+                Ok(set) => texcoord_set = set,
+                Err(reason) => warnings.push(file, "metallic-roughness textures not read", || {
+                    format!(
+                        "{}: material {}: metallicRoughnessTexture not read: {reason}; metallicFactor and roughnessFactor are used instead",
+                        shown_path(file),
+                        shown_name(&name)
+                    )
+                }),
+            }
+        }
     }
     let strength = source.emissive_strength().unwrap_or(1.0);
     material.ke = Vec3::from(source.emissive_factor()) * strength;
@@ -134,7 +152,6 @@ pub(super) fn convert(
         }
     }
     for (present, what) in [
-        (pbr.metallic_roughness_texture().is_some(), "metallicRoughnessTexture"),
         (source.normal_texture().is_some(), "normalTexture"),
         (source.occlusion_texture().is_some(), "occlusionTexture"),
     ] {
@@ -183,9 +200,40 @@ fn warn_cut_whole(warnings: &mut Warnings, file: &Path, name: &str, why: &str) {
     });
 }
 
-/// The base colour texture's file, placement and coordinate set; what is not honoured of it goes
-/// onto `not_read`.
-fn base_colour_texture(
+/// glTF's `metallicRoughnessTexture` onto `material`'s metallic and roughness maps: its blue
+/// channel times `metallicFactor`, its green times `roughnessFactor` (data, not colours). Returns
+/// the coordinate set the material's textures read: the base colour's (`base_set`) where it has
+/// one, since a material's textures share one set here.
+fn metallic_roughness_maps(
+    material: &mut Material,
+    info: &gltf::texture::Info,
+    base_set: Option<u32>,
+    image_path: ImagePath,
+    not_read: &mut Vec<String>,
+) -> Result<u32, String> {
+    let (path, transform, set) = texture_of(info, image_path, not_read)?;
+    let map = |channel, factor: Option<f32>| ParameterMap {
+        path: path.clone(),
+        transform,
+        channel,
+        scale: factor.unwrap_or(1.0),
+    };
+    material.map_pm = Some(map(Channel::Blue, material.metallic));
+    material.map_pr = Some(map(Channel::Green, material.roughness));
+    match base_set {
+        Some(base_set) if base_set != set => {
+            not_read.push(format!(
+                "metallicRoughnessTexture's TEXCOORD_{set} (it reads TEXCOORD_{base_set}, as the base colour does)"
+            ));
+            Ok(base_set)
+        }
+        _ => Ok(set),
+    }
+}
+
+/// A texture's file, placement and coordinate set; what is not honoured of it goes onto
+/// `not_read`.
+fn texture_of(
     info: &gltf::texture::Info,
     image_path: ImagePath,
     not_read: &mut Vec<String>,

@@ -4,10 +4,11 @@
 use super::continued::{has_continuations, joined};
 use super::text::{LONE_CARRIAGE_RETURNS, Tokens, finite_f32, has_lone_carriage_returns, lines};
 use crate::error::{quote, shown_path};
-use crate::materials::{Material, MaterialKind};
+use crate::materials::{Material, MaterialKind, ParameterMap};
 use crate::math::UvTransform;
 use crate::scene::load::path_from_bytes;
 use crate::scene::load::warnings::Warnings;
+use crate::textures::Channel;
 use glam::Vec3;
 use std::path::{Path, PathBuf};
 
@@ -162,6 +163,8 @@ enum Statement {
     TransmissionFilter(Vec3),
     Metallic(f32),
     Roughness(f32),
+    MetallicMap(TextureMap),
+    RoughnessMap(TextureMap),
     /// A statement lumiere does not render (bump maps, specular maps, ...), by keyword.
     Unsupported(String),
 }
@@ -173,6 +176,8 @@ impl Statement {
         let (keyword, options) = match self {
             Statement::DiffuseMap(map) => ("map_Kd", &map.options),
             Statement::CoverageMap(map) => ("map_d", &map.options),
+            Statement::MetallicMap(map) => ("map_Pm", &map.options),
+            Statement::RoughnessMap(map) => ("map_Pr", &map.options),
             _ => return Vec::new(),
         };
         options.iter().map(|option| quote(format!("{keyword} {option}"))).collect()
@@ -197,6 +202,8 @@ impl Statement {
             Statement::TransmissionFilter(tf) => material.tf = tf,
             Statement::Metallic(pm) => material.metallic = Some(pm),
             Statement::Roughness(pr) => material.roughness = Some(pr),
+            Statement::MetallicMap(map) => material.map_pm = Some(map.into_parameter()),
+            Statement::RoughnessMap(map) => material.map_pr = Some(map.into_parameter()),
             Statement::Unsupported(keyword) => notes.note_unsupported(quote(&keyword)),
             Statement::NewMtl(_) | Statement::NamelessMtl | Statement::Transparency(_) => {}
         }
@@ -228,6 +235,8 @@ fn parse_statement(line: &[u8], folder: &Path) -> Result<Option<Statement>, Stri
         b"Tf" => Statement::TransmissionFilter(color(tokens)?),
         b"Pm" => Statement::Metallic(scalar(tokens)?),
         b"Pr" => Statement::Roughness(scalar(tokens)?),
+        b"map_Pm" => Statement::MetallicMap(texture_map("map_Pm", tokens, folder)?),
+        b"map_Pr" => Statement::RoughnessMap(texture_map("map_Pr", tokens, folder)?),
         // Comments, and ambient terms, which have no meaning in a physically based renderer.
         keyword if keyword.starts_with(b"#") || HARMLESS.contains(&keyword) => return Ok(None),
         keyword => Statement::Unsupported(String::from_utf8_lossy(keyword).into_owned()),
@@ -288,12 +297,38 @@ fn illumination<'a>(mut tokens: impl Iterator<Item = &'a [u8]>) -> Result<u32, S
     }
 }
 
-/// A texture statement: the file, where it lies on the surface, and the options written before
-/// it that lumiere ignores.
+/// A texture statement: the file, where it lies on the surface, the channel a scalar map reads
+/// (`-imfchan`), and the options written before it that lumiere ignores.
 struct TextureMap {
     path: PathBuf,
     transform: UvTransform,
+    channel: Channel,
     options: Vec<String>,
+}
+
+impl TextureMap {
+    /// The map as a material parameter (`map_Pm`, `map_Pr`): its value replaces the constant, as
+    /// `map_Kd` replaces `Kd`.
+    fn into_parameter(self) -> ParameterMap {
+        ParameterMap { path: self.path, transform: self.transform, channel: self.channel, scale: 1.0 }
+    }
+}
+
+/// Whether texture statement `keyword` paints a scalar, whose channel `-imfchan` chooses.
+fn is_scalar_map(keyword: &str) -> bool {
+    matches!(keyword, "map_Pm" | "map_Pr")
+}
+
+/// The channel `-imfchan VALUE` chooses, among those lumiere reads: `r`, `g`, `b`, or `l` (the
+/// luminance, the specification's default for scalar maps).
+fn channel(value: &[u8]) -> Option<Channel> {
+    match value.to_ascii_lowercase()[..] {
+        [b'r'] => Some(Channel::Red),
+        [b'g'] => Some(Channel::Green),
+        [b'b'] => Some(Channel::Blue),
+        [b'l'] => Some(Channel::Luminance),
+        _ => None,
+    }
 }
 
 /// How many values a texture option takes, at least and at most (the MTL specification): `-s`,
@@ -335,10 +370,11 @@ fn asks_for_the_default(option: &[u8], values: &[&[u8]]) -> bool {
 /// Parses `[options] file`: options come first, each a token that starts with `-` and is not a
 /// number, with its values; the rest of the line, spaces included, is the file (Blender writes
 /// names with spaces unquoted). `-s` and `-o` place the texture (their u and v; w is for 3D
-/// textures); `-clamp off` is the default, repeat wrapping; the others are returned to be warned
-/// about. Backslashes become slashes, since files exported on Windows use them as separators.
+/// textures); `-imfchan r|g|b|l` chooses a scalar map's channel; `-clamp off` is the default,
+/// repeat wrapping; the others are returned to be warned about. Backslashes become slashes, since files exported on Windows use them as separators.
 fn texture_map(keyword: &str, mut tokens: Tokens, folder: &Path) -> Result<TextureMap, String> {
     let mut transform = UvTransform::default();
+    let mut channel_read = Channel::Luminance;
     let mut options = Vec::new();
     loop {
         let mut ahead = tokens.clone();
@@ -352,7 +388,12 @@ fn texture_map(keyword: &str, mut tokens: Tokens, folder: &Path) -> Result<Textu
         let values = take_values(keyword, option, arity, &mut tokens)?;
         // The values of `-s` and `-o` are finite numbers (`take_values`).
         let number = |k: usize, default: f32| values.get(k).and_then(|v| finite_f32(v).ok()).unwrap_or(default);
+        let chosen = match (option, &values[..]) {
+            (b"-imfchan", [value]) if is_scalar_map(keyword) => channel(value),
+            _ => None,
+        };
         match option {
+            _ if let Some(chosen) = chosen => channel_read = chosen,
             b"-s" => transform.scale = glam::Vec2::new(number(0, 1.0), number(1, 1.0)),
             b"-o" => transform.offset = glam::Vec2::new(number(0, 0.0), number(1, 0.0)),
             _ if asks_for_the_default(option, &values) => {}
@@ -364,7 +405,7 @@ fn texture_map(keyword: &str, mut tokens: Tokens, folder: &Path) -> Result<Textu
         return Err(format!("{keyword} without a file name"));
     }
     let file: Vec<u8> = file.iter().map(|&b| if b == b'\\' { b'/' } else { b }).collect();
-    Ok(TextureMap { path: folder.join(path_from_bytes(file)), transform, options })
+    Ok(TextureMap { path: folder.join(path_from_bytes(file)), transform, channel: channel_read, options })
 }
 
 /// Takes the values of texture option `option` (with `arity`, from [`option_values`]) off

@@ -18,6 +18,9 @@ use crate::scene::mesh::NO_INDEX;
 use crate::textures::{TextureId, TextureSet};
 use crate::util::hash::mix64;
 use crate::util::memory::prefetch;
+use parameters::ParameterTextures;
+
+mod parameters;
 
 pub struct World {
     scene: Scene,
@@ -30,6 +33,9 @@ pub struct World {
     /// moves the texture: most scenes have none, and a lookup then costs what it did without.
     texture_of_material: Vec<Option<(TextureId, Option<UvTransform>)>>,
     textures: TextureSet,
+    /// The textures that paint materials' metallic weight and roughness, which make a PBR
+    /// material's kind vary over its surface.
+    parameters: ParameterTextures,
     /// How each material's surface is cut out, if it is: rays pass through it where its coverage
     /// fails the material's test ([`World::opaque_at`]).
     cutout_of_material: Vec<Option<Cutout>>,
@@ -92,6 +98,9 @@ impl World {
         let (texture_of_material, textures, mut warnings) =
             TextureSet::for_materials(scene.materials.iter().map(|m| m.map_kd.as_deref()), &scene.embedded_images);
         let texture_of_material = placed(texture_of_material, scene.materials.iter().map(|m| m.map_kd_transform));
+        let (parameters, parameter_warnings) =
+            ParameterTextures::for_materials(&scene.materials, &scene.embedded_images);
+        warnings.extend(parameter_warnings);
         warnings.extend(scene.materials.iter().filter_map(Material::ignored_mask_warning));
         let (cutout_of_material, cutouts, cutout_warnings) =
             TextureSet::for_cutouts(scene.materials.iter().map(Material::cutout_mask), &scene.embedded_images);
@@ -105,7 +114,8 @@ impl World {
             .collect();
         let cuts = cutout_of_material.iter().flatten().any(|cutout| cutout.may_cut(&cutouts));
         let diameter = scene.bounds().extent().length();
-        let prefetches = scene.mesh.memory_bytes() + textures.memory_bytes() > PREFETCH_ABOVE_BYTES;
+        let texture_bytes = textures.memory_bytes() + parameters.memory_bytes();
+        let prefetches = scene.mesh.memory_bytes() + texture_bytes > PREFETCH_ABOVE_BYTES;
         World {
             scene,
             accel,
@@ -113,6 +123,7 @@ impl World {
             kinds,
             texture_of_material,
             textures,
+            parameters,
             cutout_of_material,
             cutouts,
             cuts,
@@ -156,12 +167,15 @@ impl World {
         self.diameter
     }
 
-    /// The stable hashes of the files material `material`'s diffuse and coverage textures were
-    /// decoded from, `None` where it has none or its file could not be used.
-    pub fn texture_contents(&self, material: usize) -> [Option<u64>; 2] {
+    /// The stable hashes of the files material `material`'s diffuse, coverage, metallic and
+    /// roughness textures were decoded from, `None` where it has none or its file could not be
+    /// used.
+    pub fn texture_contents(&self, material: usize) -> [Option<u64>; 4] {
         let cutout = self.cutout_of_material[material].and_then(|cutout| cutout.texture);
-        [(self.texture_of_material[material], &self.textures), (cutout, &self.cutouts)]
-            .map(|(texture, set)| texture.map(|(id, _)| set.contents_hash(id)))
+        let [diffuse, coverage] = [(self.texture_of_material[material], &self.textures), (cutout, &self.cutouts)]
+            .map(|(texture, set)| texture.map(|(id, _)| set.contents_hash(id)));
+        let [metallic, roughness] = self.parameters.contents(material);
+        [diffuse, coverage, metallic, roughness]
     }
 
     /// Problems met while deriving the world (a texture that could not be decoded).
@@ -169,11 +183,14 @@ impl World {
         &self.warnings
     }
 
-    /// The scattering function at a surface point: its material's kind with the colour of its
-    /// texture there, or its `Kd`.
+    /// The scattering function at a surface point: its material's kind (with the metallic weight
+    /// and roughness its textures paint there, if they do) with the colour of its texture there,
+    /// or its `Kd`.
     #[inline]
     pub fn bsdf(&self, surface: &SurfacePoint) -> MaterialBsdf {
-        self.kinds[surface.material as usize].bsdf(self.base_colour(surface.material, surface.uv))
+        let id = surface.material as usize;
+        let kind = self.parameters.kind_at(id, surface.uv).unwrap_or(self.kinds[id]);
+        kind.bsdf(self.base_colour(surface.material, surface.uv))
     }
 
     /// The reflectance of the [`World::bsdf`] of material `material` at texture coordinates `uv`,
