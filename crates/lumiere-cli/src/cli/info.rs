@@ -90,9 +90,10 @@ fn describe(material: &Material) -> String {
         MaterialKind::Mirror { f0 } => Some(format!("F0 {}", vector(f0))),
         MaterialKind::Dielectric { eta, tf } => Some(format!("eta {}, Tf {}", number(eta), vector(tf))),
     };
-    let scattering = match details {
-        Some(details) => format!("{} ({details})", kind.name()),
-        None => kind.name().to_string(),
+    let scattering = match (painted_scattering(material), details) {
+        (Some(painted), _) => painted,
+        (None, Some(details)) => format!("{} ({details})", kind.name()),
+        (None, None) => kind.name().to_string(),
     };
     let mut parts = vec![scattering];
     // A mirror of `Ks` and glass ignore the base colour.
@@ -120,6 +121,24 @@ fn describe(material: &Material) -> String {
         parts.push(format!("Ke {} (a light)", vector(material.ke)));
     }
     parts.join(", ")
+}
+
+/// The scattering of a PBR material whose metallic weight or roughness a map paints, which
+/// varies over its surface: `None` for the others.
+fn painted_scattering(material: &Material) -> Option<String> {
+    if material.map_pm.is_none() && material.map_pr.is_none() {
+        return None;
+    }
+    let alpha = if material.map_pr.is_some() {
+        "alpha from map_Pr".to_string()
+    } else {
+        format!("alpha {}", number(material.pbr_alpha()))
+    };
+    Some(match (&material.map_pm, material.metallic.is_some_and(|pm| pm >= 0.5)) {
+        (Some(_), _) => format!("conductor where map_Pm reaches 0.5, plastic (Ks 0.04) elsewhere ({alpha})"),
+        (None, true) => format!("conductor (F0 the base colour, {alpha})"),
+        (None, false) => format!("plastic (Ks 0.04, {alpha})"),
+    })
 }
 
 /// How a coverage test other than MTL's cuts: `coverage` names what it reads.

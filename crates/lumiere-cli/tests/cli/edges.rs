@@ -635,10 +635,16 @@ fn info_names_materials_and_prints_no_negative_zero() {
     assert!(text.contains("\"light.001\": 2 triangles, lambert, Kd") && text.contains("(a light)"), "{text}");
     assert!(text.contains("materials  8"), "{text}");
     let dir = TempDir::new("info-kinds");
-    dir.write("kinds.mtl", "newmtl glass\nKd 0 0 0\nKs 1 1 1\nNi 1.5\nillum 7\nnewmtl mirror\nKd 0 0 0\nKs 1 1 1\nillum 3\nnewmtl brass\nKd 0.5 0.4 0.3\nPm 1\nPr 0.5\n");
+    dir.write(
+        "kinds.mtl",
+        "newmtl glass\nKd 0 0 0\nKs 1 1 1\nNi 1.5\nillum 7\nnewmtl mirror\nKd 0 0 0\nKs 1 1 1\nillum 3\n\
+         newmtl brass\nKd 0.5 0.4 0.3\nPm 1\nPr 0.5\nnewmtl painted\nmap_Pm -imfchan b orm.png\nmap_Pr -imfchan g orm.png\n\
+         newmtl worn\nPm 1\nmap_Pr -s 2 2 worn.png\n",
+    );
     let scene = dir.write(
         "kinds.obj",
-        "mtllib kinds.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl glass\nf 1 2 3\nusemtl mirror\nf 1 2 3\nusemtl brass\nf 1 2 3\n",
+        "mtllib kinds.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl glass\nf 1 2 3\nusemtl mirror\nf 1 2 3\nusemtl brass\nf 1 2 3\n\
+         usemtl painted\nf 1 2 3\nusemtl worn\nf 1 2 3\n",
     );
     let out = run(&["info", scene.to_str().unwrap()]);
     let text = String::from_utf8_lossy(&out.stdout);
@@ -651,6 +657,23 @@ fn info_names_materials_and_prints_no_negative_zero() {
         text.contains("\"brass\": 1 triangles, conductor (F0 the base colour, alpha 0.250000), Kd (0.500000"),
         "{text}"
     );
+    // Where maps paint the metallic weight or the roughness, the kind varies over the surface.
+    let orm = dir.path("orm.png").display().to_string();
+    assert!(
+        text.contains(&format!(
+            "\"painted\": 1 triangles, conductor where map_Pm reaches 0.5, plastic (Ks 0.04) elsewhere (alpha from \
+             map_Pr), Kd (0.800000, 0.800000, 0.800000), map_Pm {orm:?} (blue x 1.000000), map_Pr {orm:?} (green x 1.000000)\n"
+        )),
+        "{text}"
+    );
+    assert!(text.contains("\"worn\": 1 triangles, conductor (F0 the base colour, alpha from map_Pr)"), "{text}");
+    assert!(text.contains("map_Pr -s 2.000000 2.000000 -o 0.000000 0.000000 \""), "{text}");
+    // The maps' files are missing: named once each, as a render would.
+    for file in ["orm.png", "worn.png"] {
+        let warning = format!("{:?}: ", dir.path(file).display().to_string());
+        assert_eq!(stderr(&out).matches(&warning).count(), 1, "{}", stderr(&out));
+    }
+    assert!(stderr(&out).contains("; the material's metallic and roughness values are used instead"), "{}", stderr(&out));
     let dir = TempDir::new("info-unlit");
     let scene = dir.write("unlit.obj", "v 0 0 0\nv -1 0 0\nv 0 -1 0\nf 1 2 3\n");
     let out = run(&["info", scene.to_str().unwrap()]);
