@@ -190,6 +190,7 @@ impl PyScene {
             for (key, map) in [("metallic_texture", &material.map_pm), ("roughness_texture", &material.map_pr)] {
                 entry.set_item(key, map.as_ref().map(|map| map.path.display().to_string()))?;
             }
+            entry.set_item("normal_texture", material.normal_map.as_ref().map(|map| map.path.display().to_string()))?;
             entry.set_item("light", material.is_emissive())?;
             materials.set_item(&material.name, entry)?;
         }

@@ -2,6 +2,7 @@
 //! the scattering each maps to and their textures, lights, bounds — and its load warnings.
 
 use std::fmt::Display;
+use std::path::Path;
 use std::time::Instant;
 
 use glam::Vec3;
@@ -13,7 +14,7 @@ use lumiere::materials::{CoverageTest, Cut, Material, MaterialKind};
 use lumiere::math::UvTransform;
 use lumiere::scene::Scene;
 use lumiere::scene::camera::View;
-use lumiere::textures::TextureSet;
+use lumiere::textures::{TextureSet, TextureUse};
 
 use super::args::InfoArgs;
 use super::output;
@@ -34,10 +35,7 @@ pub fn run(args: &InfoArgs) -> Result<()> {
     for warning in materials.iter().filter_map(Material::ignored_mask_warning) {
         output::warn(warning);
     }
-    let (map_kd, map_d) = (materials.iter().map(|m| m.map_kd.as_deref()), materials.iter().map(Material::cutout_mask));
-    let parameter_maps =
-        materials.iter().flat_map(|m| [&m.map_pm, &m.map_pr]).map(|map| map.as_ref().map(|map| map.path.as_path()));
-    for warning in TextureSet::unreadable_files(map_kd, map_d, parameter_maps, &scene.embedded_images) {
+    for warning in TextureSet::unreadable_files(textures_named(materials), &scene.embedded_images) {
         output::warn(warning);
     }
     let lights = LightSet::new(&scene);
@@ -74,13 +72,23 @@ pub fn run(args: &InfoArgs) -> Result<()> {
     Ok(())
 }
 
+/// Every texture file `materials` name, with its use, in the order a render decodes them.
+fn textures_named(materials: &[Material]) -> impl Iterator<Item = (TextureUse, Option<&Path>)> {
+    let diffuse = materials.iter().map(|m| (TextureUse::Diffuse, m.map_kd.as_deref()));
+    let coverage = materials.iter().map(|m| (TextureUse::Coverage, m.cutout_mask()));
+    let parameters = materials.iter().flat_map(|m| [&m.map_pm, &m.map_pr]);
+    let parameters = parameters.map(|map| (TextureUse::Parameters, map.as_ref().map(|map| map.path.as_path())));
+    let normals = materials.iter().map(|m| (TextureUse::Normals, m.normal_map.as_ref().map(|map| map.path.as_path())));
+    diffuse.chain(coverage).chain(parameters).chain(normals)
+}
+
 fn line(key: &str, value: impl Display) -> Result<()> {
     output::print(format_args!("{key:<11}{value}"))
 }
 
 /// What lumiere uses of a material: the scattering its statements map to (docs/MATERIALS.md), its
-/// colour, its texture, the maps that paint its metallic weight and roughness, its cutout mask,
-/// its emission.
+/// colour, its texture, the maps that paint its metallic weight and roughness, its normal map,
+/// its cutout mask, its emission.
 fn describe(material: &Material) -> String {
     let kind = material.kind();
     let details = match kind {
@@ -109,6 +117,10 @@ fn describe(material: &Material) -> String {
             let path = map.path.display().to_string();
             parts.push(format!("{keyword} {}{path:?} ({channel} x {})", placement(map.transform), number(map.scale)));
         }
+    }
+    if let Some(map) = &material.normal_map {
+        let path = map.path.display().to_string();
+        parts.push(format!("normal map {}{path:?} (scale {})", placement(map.transform), number(map.scale)));
     }
     let test = material.map_d_test;
     if let Some(mask) = material.cutout_mask() {

@@ -673,7 +673,11 @@ fn info_names_materials_and_prints_no_negative_zero() {
         let warning = format!("{:?}: ", dir.path(file).display().to_string());
         assert_eq!(stderr(&out).matches(&warning).count(), 1, "{}", stderr(&out));
     }
-    assert!(stderr(&out).contains("; the material's metallic and roughness values are used instead"), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("; the material's metallic and roughness values are used instead"),
+        "{}",
+        stderr(&out)
+    );
     let dir = TempDir::new("info-unlit");
     let scene = dir.write("unlit.obj", "v 0 0 0\nv -1 0 0\nv 0 -1 0\nf 1 2 3\n");
     let out = run(&["info", scene.to_str().unwrap()]);

@@ -79,6 +79,22 @@ pub struct Material {
     /// `metallicRoughnessTexture`'s green channel): where it decodes, its value at the hit
     /// replaces `roughness`.
     pub map_pr: Option<ParameterMap>,
+    /// A tangent-space normal map (glTF's `normalTexture`) that bends the shading normal.
+    pub normal_map: Option<NormalMap>,
+}
+
+/// A tangent-space normal map: each texel's stored values `c` (data, not a colour), as `2c − 1`,
+/// are a direction in the frame of the surface's texture axes (`x` along increasing `u`, `y`
+/// along increasing `v`, glTF's and OpenGL's convention) and its shading normal (`z`), its `x`
+/// and `y` multiplied by `scale`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NormalMap {
+    /// The name of an image the scene file embeds, or a file's path.
+    pub path: PathBuf,
+    /// Where the texture lies on the surface.
+    pub transform: UvTransform,
+    /// glTF's `normalTexture.scale`: how strongly the map bends the normal (1 as drawn).
+    pub scale: f32,
 }
 
 /// A material parameter painted by a texture: one channel of the values its file stores (data,
@@ -246,6 +262,7 @@ impl Material {
             roughness: None,
             map_pm: None,
             map_pr: None,
+            normal_map: None,
         }
     }
 

@@ -27,7 +27,8 @@ pub use conductor::{Conductor, Mirror};
 pub use dielectric::Dielectric;
 pub use lambert::Lambert;
 pub use material::{
-    CoverageTest, Cut, DEFAULT_IOR, Material, MaterialKind, ParameterMap, SMOOTH_NS, alpha_from_ns, pbr_alpha,
+    CoverageTest, Cut, DEFAULT_IOR, Material, MaterialKind, NormalMap, ParameterMap, SMOOTH_NS, alpha_from_ns,
+    pbr_alpha,
 };
 pub use plastic::Plastic;
 

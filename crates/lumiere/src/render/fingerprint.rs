@@ -59,6 +59,12 @@ pub fn scene_fingerprint(world: &World) -> u64 {
                 h.write_f32s([map.scale]);
             }
         }
+        if let Some(map) = &m.normal_map {
+            h.write(b"normal map");
+            h.write(map.path.as_os_str().as_encoded_bytes());
+            h.write_f32s([map.transform.scale, map.transform.offset].iter().flat_map(|v| v.to_array()));
+            h.write_f32s([map.scale]);
+        }
         // The same for the textures' placements, hashed only where they move a texture.
         for (key, transform) in [(&b"map_kd -s -o"[..], m.map_kd_transform), (&b"map_d -s -o"[..], m.map_d_transform)] {
             if !transform.is_identity() {
@@ -69,12 +75,13 @@ pub fn scene_fingerprint(world: &World) -> u64 {
         // And the bytes of the files the textures were decoded from: a file edited (or made
         // usable) between two sessions of a render changes its image. Only where a texture is
         // named, so that the fingerprints of scenes without one stay what they were.
-        let [map_kd, map_d, map_pm, map_pr] = world.texture_contents(index);
+        let [map_kd, map_d, map_pm, map_pr, normals] = world.texture_contents(index);
         for (key, named, contents) in [
             (&b"map_kd file"[..], m.map_kd.is_some(), map_kd),
             (&b"map_d file"[..], m.map_d.is_some(), map_d),
             (&b"map_Pm file"[..], m.map_pm.is_some(), map_pm),
             (&b"map_Pr file"[..], m.map_pr.is_some(), map_pr),
+            (&b"normal map file"[..], m.normal_map.is_some(), normals),
         ] {
             if named {
                 h.write(key);

@@ -44,13 +44,14 @@ impl Scene {
     }
 
     /// The files read besides the scene file itself: the material libraries or buffers, then every
-    /// texture file the materials name (`map_Kd`, `map_d`, `map_Pm`, `map_Pr`; not the images embedded in the scene
+    /// texture file the materials name (`map_Kd`, `map_d`, `map_Pm`, `map_Pr`, normal maps; not the images embedded in the scene
     /// file), whether or not it could be decoded. No output may overwrite one
     /// (`util::overwrite::check_scene_files`).
     pub fn files_read(&self) -> impl Iterator<Item = &Path> {
         let textures = self.materials.iter().flat_map(|m| {
             let parameter_maps = [&m.map_pm, &m.map_pr].map(|map| map.as_ref().map(|map| map.path.as_path()));
-            [m.map_kd.as_deref(), m.map_d.as_deref()].into_iter().chain(parameter_maps)
+            let normal_map = m.normal_map.as_ref().map(|map| map.path.as_path());
+            [m.map_kd.as_deref(), m.map_d.as_deref(), normal_map].into_iter().chain(parameter_maps)
         });
         let textures = textures.flatten();
         let textures = textures.filter(|texture| !self.embedded_images.contains(texture));

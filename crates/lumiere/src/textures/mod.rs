@@ -255,6 +255,13 @@ impl Texture {
         self.sample_channel(uv, Channel::Luminance)
     }
 
+    /// The bilinearly filtered values the file stores at `uv` (not decoded from sRGB): data such
+    /// as a normal map's directions.
+    #[inline]
+    pub fn sample_stored(&self, uv: Vec2) -> Vec3 {
+        self.footprint(uv).iter().map(|&(i, w)| self.rgb.stored(i) * w).fold(Vec3::ZERO, |sum, value| sum + value)
+    }
+
     /// The bilinearly filtered value of `channel` at `uv`, read from the values the file stores
     /// (not decoded from sRGB): a material parameter painted by the texture, such as a roughness.
     #[inline]
@@ -453,13 +460,13 @@ impl TextureSet {
     /// that decoded, with one warning for each path that did not, in the order of `paths`:
     /// `texture "PATH": REASON; the material's Kd is used instead`.
     pub fn load<P: AsRef<Path> + Sync>(paths: &[P]) -> (TextureSet, Vec<String>) {
-        TextureSet::load_or(paths, WITHOUT_DIFFUSE, &EmbeddedImages::default())
+        TextureSet::load_or(paths, TextureUse::Diffuse.instead(), &EmbeddedImages::default())
     }
 
     /// [`TextureSet::load`] with `available` bytes of memory, instead of what the system reports
     /// ([`crate::util::read::available_memory`]): for tests of a machine short of memory.
     pub fn load_with_memory<P: AsRef<Path> + Sync>(paths: &[P], available: u64) -> (TextureSet, Vec<String>) {
-        TextureSet::load_within(paths, WITHOUT_DIFFUSE, Some(available), &EmbeddedImages::default())
+        TextureSet::load_within(paths, TextureUse::Diffuse.instead(), Some(available), &EmbeddedImages::default())
     }
 
     /// [`TextureSet::load`], whose warnings end with `instead` (what the material does without
@@ -518,7 +525,7 @@ impl TextureSet {
         map_kd: impl IntoIterator<Item = Option<&'a Path>>,
         embedded: &EmbeddedImages,
     ) -> (Vec<Option<TextureId>>, TextureSet, Vec<String>) {
-        TextureSet::per_material(map_kd, WITHOUT_DIFFUSE, embedded)
+        TextureSet::for_use(TextureUse::Diffuse, map_kd, embedded)
     }
 
     /// As [`TextureSet::for_materials`], for each material's coverage texture (`map_d`, for
@@ -527,62 +534,45 @@ impl TextureSet {
         map_d: impl IntoIterator<Item = Option<&'a Path>>,
         embedded: &EmbeddedImages,
     ) -> (Vec<Option<TextureId>>, TextureSet, Vec<String>) {
-        TextureSet::per_material(map_d, WITHOUT_COVERAGE, embedded)
+        TextureSet::for_use(TextureUse::Coverage, map_d, embedded)
     }
 
-    /// As [`TextureSet::for_materials`], for the textures that paint material parameters
-    /// (`map_Pm`, `map_Pr`, glTF's `metallicRoughnessTexture`): a file that fails leaves its
-    /// material its constant values.
-    pub fn for_parameters<'a>(
-        maps: impl IntoIterator<Item = Option<&'a Path>>,
-        embedded: &EmbeddedImages,
-    ) -> (Vec<Option<TextureId>>, TextureSet, Vec<String>) {
-        TextureSet::per_material(maps, WITHOUT_PARAMETER, embedded)
-    }
-
-    /// The warnings [`TextureSet::for_materials`], [`TextureSet::for_cutouts`] and
-    /// [`TextureSet::for_parameters`] would give for the files among `map_kd`, `map_d` and
-    /// `parameter_maps` that are missing, not regular files or too large: the checks that need no
-    /// decoding, so they cost no more than a file's metadata (what `lumiere info` shows). Images
-    /// `embedded` in the scene file are not files: they are checked when they are decoded.
-    pub fn unreadable_files<'a>(
-        map_kd: impl IntoIterator<Item = Option<&'a Path>>,
-        map_d: impl IntoIterator<Item = Option<&'a Path>>,
-        parameter_maps: impl IntoIterator<Item = Option<&'a Path>>,
-        embedded: &EmbeddedImages,
-    ) -> Vec<String> {
-        let mut warnings = Vec::new();
-        for (paths, instead) in [
-            (map_kd.into_iter().collect::<Vec<_>>(), WITHOUT_DIFFUSE),
-            (map_d.into_iter().collect(), WITHOUT_COVERAGE),
-            (parameter_maps.into_iter().collect(), WITHOUT_PARAMETER),
-        ] {
-            let mut seen: Vec<&Path> = Vec::new();
-            for path in paths.into_iter().flatten() {
-                if seen.contains(&path) || embedded.contains(path) {
-                    continue;
-                }
-                seen.push(path);
-                if let Err(reason) = check_file(path) {
-                    warnings.push(unusable(path, &reason, instead));
-                }
-            }
-        }
-        warnings
-    }
-
-    /// One optional texture path per material → each material's texture id, the set, and the
-    /// warnings of [`TextureSet::load_or`].
-    fn per_material<'a>(
+    /// As [`TextureSet::for_materials`], for textures of any use: one optional path per
+    /// material, and the warnings of [`TextureSet::load`] ending with what the material does
+    /// without a texture of that use.
+    pub fn for_use<'a>(
+        texture_use: TextureUse,
         paths: impl IntoIterator<Item = Option<&'a Path>>,
-        instead: &str,
         embedded: &EmbeddedImages,
     ) -> (Vec<Option<TextureId>>, TextureSet, Vec<String>) {
         let paths: Vec<Option<&Path>> = paths.into_iter().collect();
         let distinct: Vec<&Path> = paths.iter().flatten().copied().collect();
-        let (set, warnings) = TextureSet::load_or(&distinct, instead, embedded);
+        let (set, warnings) = TextureSet::load_or(&distinct, texture_use.instead(), embedded);
         let ids = paths.iter().map(|path| path.and_then(|p| set.id_of(p))).collect();
         (ids, set, warnings)
+    }
+
+    /// The warnings [`TextureSet::for_use`] would give for the `files` (each with its use) that
+    /// are missing, not regular files or too large: the checks that need no decoding, so they
+    /// cost no more than a file's metadata (what `lumiere info` shows). Images `embedded` in the
+    /// scene file are not files: they are checked when they are decoded.
+    pub fn unreadable_files<'a>(
+        files: impl IntoIterator<Item = (TextureUse, Option<&'a Path>)>,
+        embedded: &EmbeddedImages,
+    ) -> Vec<String> {
+        let mut warnings = Vec::new();
+        let mut seen: Vec<(TextureUse, &Path)> = Vec::new();
+        for (texture_use, path) in files {
+            let Some(path) = path else { continue };
+            if seen.contains(&(texture_use, path)) || embedded.contains(path) {
+                continue;
+            }
+            seen.push((texture_use, path));
+            if let Err(reason) = check_file(path) {
+                warnings.push(unusable(path, &reason, texture_use.instead()));
+            }
+        }
+        warnings
     }
 
     /// The id of the texture decoded from `path`, if it decoded.
@@ -627,11 +617,32 @@ impl TextureSet {
     }
 }
 
-/// What a material does without its diffuse texture, its coverage texture, or a texture that
-/// paints its parameters: the end of each warning about a file that cannot be used.
-const WITHOUT_DIFFUSE: &str = "the material's Kd is used instead";
-const WITHOUT_COVERAGE: &str = "the material stays opaque";
-const WITHOUT_PARAMETER: &str = "the material's metallic and roughness values are used instead";
+/// What a texture is for, which decides what its material does without it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TextureUse {
+    /// The base colour (`map_Kd`, glTF's `baseColorTexture`).
+    Diffuse,
+    /// A cutout's coverage (`map_d`, glTF's alpha).
+    Coverage,
+    /// A material's metallic weight or roughness (`map_Pm`, `map_Pr`, glTF's
+    /// `metallicRoughnessTexture`).
+    Parameters,
+    /// A tangent-space normal map (glTF's `normalTexture`).
+    Normals,
+}
+
+impl TextureUse {
+    /// What a material does without its texture: the end of each warning about a file that
+    /// cannot be used.
+    fn instead(self) -> &'static str {
+        match self {
+            TextureUse::Diffuse => "the material's Kd is used instead",
+            TextureUse::Coverage => "the material stays opaque",
+            TextureUse::Parameters => "the material's metallic and roughness values are used instead",
+            TextureUse::Normals => "the surface keeps its interpolated normals",
+        }
+    }
+}
 
 /// The warning about texture file `path`: quoted and escaped like a string literal (not cut: the
 /// user must find the file), so that a control character from the MTL file cannot garble the line.

@@ -11,15 +11,17 @@ use crate::geometry::surface::SurfacePoint;
 use crate::geometry::surface_lanes::{HitCorners, SurfaceRows};
 use crate::lights::LightSet;
 use crate::materials::{CoverageTest, Material, MaterialBsdf, MaterialKind};
-use crate::math::rows::{Rows, set_row};
+use crate::math::rows::{Rows, row, set_row};
 use crate::math::{Ray, UvTransform};
 use crate::scene::Scene;
 use crate::scene::mesh::NO_INDEX;
 use crate::textures::{TextureId, TextureSet};
 use crate::util::hash::mix64;
 use crate::util::memory::prefetch;
+use normals::{Corners, NormalMaps};
 use parameters::ParameterTextures;
 
+mod normals;
 mod parameters;
 
 pub struct World {
@@ -36,6 +38,8 @@ pub struct World {
     /// The textures that paint materials' metallic weight and roughness, which make a PBR
     /// material's kind vary over its surface.
     parameters: ParameterTextures,
+    /// The normal maps that bend materials' shading normals.
+    normal_maps: NormalMaps,
     /// How each material's surface is cut out, if it is: rays pass through it where its coverage
     /// fails the material's test ([`World::opaque_at`]).
     cutout_of_material: Vec<Option<Cutout>>,
@@ -101,6 +105,8 @@ impl World {
         let (parameters, parameter_warnings) =
             ParameterTextures::for_materials(&scene.materials, &scene.embedded_images);
         warnings.extend(parameter_warnings);
+        let (normal_maps, normal_warnings) = NormalMaps::for_materials(&scene.materials, &scene.embedded_images);
+        warnings.extend(normal_warnings);
         warnings.extend(scene.materials.iter().filter_map(Material::ignored_mask_warning));
         let (cutout_of_material, cutouts, cutout_warnings) =
             TextureSet::for_cutouts(scene.materials.iter().map(Material::cutout_mask), &scene.embedded_images);
@@ -114,7 +120,7 @@ impl World {
             .collect();
         let cuts = cutout_of_material.iter().flatten().any(|cutout| cutout.may_cut(&cutouts));
         let diameter = scene.bounds().extent().length();
-        let texture_bytes = textures.memory_bytes() + parameters.memory_bytes();
+        let texture_bytes = textures.memory_bytes() + parameters.memory_bytes() + normal_maps.memory_bytes();
         let prefetches = scene.mesh.memory_bytes() + texture_bytes > PREFETCH_ABOVE_BYTES;
         World {
             scene,
@@ -124,6 +130,7 @@ impl World {
             texture_of_material,
             textures,
             parameters,
+            normal_maps,
             cutout_of_material,
             cutouts,
             cuts,
@@ -167,15 +174,15 @@ impl World {
         self.diameter
     }
 
-    /// The stable hashes of the files material `material`'s diffuse, coverage, metallic and
-    /// roughness textures were decoded from, `None` where it has none or its file could not be
-    /// used.
-    pub fn texture_contents(&self, material: usize) -> [Option<u64>; 4] {
+    /// The stable hashes of the files material `material`'s diffuse, coverage, metallic,
+    /// roughness and normal textures were decoded from, `None` where it has none or its file
+    /// could not be used.
+    pub fn texture_contents(&self, material: usize) -> [Option<u64>; 5] {
         let cutout = self.cutout_of_material[material].and_then(|cutout| cutout.texture);
         let [diffuse, coverage] = [(self.texture_of_material[material], &self.textures), (cutout, &self.cutouts)]
             .map(|(texture, set)| texture.map(|(id, _)| set.contents_hash(id)));
         let [metallic, roughness] = self.parameters.contents(material);
-        [diffuse, coverage, metallic, roughness]
+        [diffuse, coverage, metallic, roughness, self.normal_maps.contents(material)]
     }
 
     /// Problems met while deriving the world (a texture that could not be decoded).
@@ -391,7 +398,23 @@ impl World {
         let ng = if front_face { geometric } else { -geometric };
         let ns = self.interpolated_normal(id, w, hit.u, hit.v).map_or(ng, |n| if n.dot(ng) < 0.0 { -n } else { n });
         let uv = self.interpolated_texcoord(id, w, hit.u, hit.v);
-        SurfacePoint { p, ng, ns, uv, triangle: hit.triangle, material: mesh.material_ids[id], front_face }
+        let material = mesh.material_ids[id];
+        let ns = self.mapped_normal(hit.triangle, material, uv, ns, ng);
+        SurfacePoint { p, ng, ns, uv, triangle: hit.triangle, material, front_face }
+    }
+
+    /// The shading normal at a hit on triangle `triangle` of material `material` whose
+    /// interpolated normal is `ns`: bent by the material's normal map, if it has one
+    /// (`world/normals.rs`).
+    #[inline]
+    fn mapped_normal(&self, triangle: u32, material: u32, uv: Vec2, ns: Vec3, ng: Vec3) -> Vec3 {
+        if !self.normal_maps.maps(material) {
+            return ns;
+        }
+        let id = triangle as usize;
+        let Some(texcoords) = self.scene.mesh.corner_texcoords(id) else { return ns };
+        let corners = Corners { positions: self.scene.mesh.vertices(id), texcoords };
+        self.normal_maps.shading_normal(material, &corners, uv, ns, ng)
     }
 
     /// [`World::surface`] of every lane of `rays` with a hit (default points elsewhere), with its
@@ -445,10 +468,20 @@ impl World {
             (corners.u[lane], corners.v[lane]) = (hit.u, hit.v);
             set_row(&mut corners.dir, lane, rays[lane].dir);
         }
-        self.simd_256(
+        let mut rows = self.simd_256(
             #[inline(always)]
             || corners.surface_rows(),
-        )
+        );
+        if !self.normal_maps.is_empty() {
+            for (lane, hit) in hits.iter().enumerate() {
+                let Some(hit) = hit else { continue };
+                let (ns, ng) = (row(&rows.ns, lane), row(&rows.ng, lane));
+                let uv = Vec2::new(rows.uv[0][lane], rows.uv[1][lane]);
+                let ns = self.mapped_normal(hit.triangle, self.material_of(hit.triangle), uv, ns, ng);
+                set_row(&mut rows.ns, lane, ns);
+            }
+        }
+        rows
     }
 
     fn interpolated_normal(&self, id: usize, w: f32, u: f32, v: f32) -> Option<Vec3> {

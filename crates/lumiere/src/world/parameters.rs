@@ -7,7 +7,7 @@ use glam::Vec2;
 
 use crate::materials::{Material, MaterialKind, ParameterMap, pbr_alpha};
 use crate::math::UvTransform;
-use crate::textures::{Channel, EmbeddedImages, TextureId, TextureSet};
+use crate::textures::{Channel, EmbeddedImages, TextureId, TextureSet, TextureUse};
 
 /// Each material's painted parameters, where it has any, and the textures they read.
 #[derive(Clone, Debug, Default)]
@@ -71,12 +71,12 @@ impl Parameter {
 
 impl ParameterTextures {
     /// Decodes the parameter maps of `materials` (or takes the images `embedded` in the scene
-    /// file), each file once, with the warnings of [`TextureSet::for_parameters`]: a map that
+    /// file), each file once, with the warnings of [`TextureSet::for_use`]: a map that
     /// cannot be used leaves its material the constant.
     pub(super) fn for_materials(materials: &[Material], embedded: &EmbeddedImages) -> (ParameterTextures, Vec<String>) {
         let paths =
             materials.iter().flat_map(|m| [&m.map_pm, &m.map_pr]).map(|map| map.as_ref().map(|map| map.path.as_path()));
-        let (ids, textures, warnings) = TextureSet::for_parameters(paths, embedded);
+        let (ids, textures, warnings) = TextureSet::for_use(TextureUse::Parameters, paths, embedded);
         let of_material = materials
             .iter()
             .zip(ids.chunks_exact(2))

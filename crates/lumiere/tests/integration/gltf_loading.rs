@@ -550,6 +550,68 @@ fn metallic_roughness_textures_paint_the_kind_at_each_hit() {
     }
 }
 
+/// A `normalTexture` bends the shading normal: its texel's direction (`2c - 1`, x and y times
+/// `scale`) in the frame of the triangle's texture axes and its normal, so a texture mirrored in
+/// `u` bends it the other way and the back of the surface sees the relief mirrored; a direction
+/// that would face away from the surface, or a map that does not decode, leaves the interpolated
+/// normal. The rows a packet shades from agree with the single point.
+#[test]
+fn normal_textures_bend_the_shading_normal_in_the_triangles_texture_frame() {
+    let mut builder = Builder::default();
+    let primitive = quad(&mut builder);
+    // The same quad with its texture mirrored in u: `∂p/∂u` along -x.
+    let positions = builder.floats(&[0., 0., 0., 1., 0., 0., 1., 1., 0., 0., 1., 0.], "VEC3");
+    let texcoords = builder.floats(&[1., 1., 0., 1., 0., 0., 1., 0.], "VEC2");
+    let indices = builder.indices(&[0, 1, 2, 0, 2, 3]);
+    let mirrored =
+        format!(r#"{{"attributes": {{"POSITION": {positions}, "TEXCOORD_0": {texcoords}}}, "indices": {indices}}}"#);
+    let texel = [204u8, 100, 230];
+    let tilted = builder.view(&encoded(image::RgbImage::from_raw(1, 1, texel.to_vec()).unwrap().into()), None);
+    let below = builder.view(&encoded(image::RgbImage::from_raw(1, 1, vec![255, 128, 0]).unwrap().into()), None);
+    let broken = builder.view(b"\x89PNG not an image", None);
+    let materials = [
+        r#"{"name": "tilted", "normalTexture": {"index": 0}}"#,
+        r#"{"name": "gentle", "normalTexture": {"index": 0, "scale": 0.5}}"#,
+        r#"{"name": "below", "normalTexture": {"index": 1}}"#,
+        r#"{"name": "broken", "normalTexture": {"index": 2}}"#,
+        r#"{"name": "mirrored", "normalTexture": {"index": 0}}"#,
+    ];
+    let images = format!(
+        r#""images": [{{"bufferView": {tilted}, "mimeType": "image/png"}}, {{"bufferView": {below}, "mimeType": "image/png"}},
+        {{"bufferView": {broken}, "mimeType": "image/png"}}], "textures": [{{"source": 0}}, {{"source": 1}}, {{"source": 2}}]"#
+    );
+    let mut rest = quad_per_material(&primitive, &materials, &images);
+    // The last material's quad is the mirrored one.
+    let last = primitive.replace(r#""indices""#, r#""material": 4, "indices""#);
+    rest = rest.replacen(&last, &mirrored.replace(r#""indices""#, r#""material": 4, "indices""#), 1);
+    let scene = parse(&builder.gltf(&rest));
+    assert_eq!(scene.materials[1].normal_map.as_ref().map(|map| map.scale), Some(0.5));
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    let world = lumiere::world::World::new(scene, lumiere::accel::BuildPreset::Default);
+    assert_eq!(world.warnings().len(), 1, "{:?}", world.warnings());
+    assert!(world.warnings()[0].ends_with("the surface keeps its interpolated normals"), "{:?}", world.warnings());
+    let c = Vec3::from(texel.map(|code| f32::from(code) / 255.0 * 2.0 - 1.0));
+    let expected =
+        [Vec3::new(c.x, c.y, c.z), Vec3::new(0.5 * c.x, 0.5 * c.y, c.z), Vec3::Z, Vec3::Z, Vec3::new(-c.x, c.y, c.z)]
+            .map(Vec3::normalize);
+    for (m, expected) in expected.into_iter().enumerate() {
+        let x = 2.0 * m as f32 + 0.3;
+        // From above, and from below, where the relief is seen mirrored through the surface.
+        for (z, expected) in [(1.0, expected), (-1.0, expected * Vec3::new(1.0, 1.0, -1.0))] {
+            let ray = Ray::new(Vec3::new(x, 0.6, z), Vec3::new(0.0, 0.0, -z));
+            let hits = [world.intersect(&ray), None];
+            let surface = world.surface(&ray, &hits[0].unwrap());
+            assert!(
+                (surface.ns - expected).abs().max_element() < 1e-5,
+                "material {m}, z {z}: {} vs {expected}",
+                surface.ns
+            );
+            let points = world.surfaces(&[ray, ray], &hits);
+            assert_eq!(points[0].ns, surface.ns, "material {m}, z {z}: the rows' normal");
+        }
+    }
+}
+
 /// The share of `rays` that `world` lets through.
 fn share_through(world: &lumiere::world::World, rays: impl Iterator<Item = Ray>) -> f64 {
     let (mut through, mut count) = (0, 0);
@@ -657,7 +719,7 @@ fn base_colour_textures_are_found_beside_the_file_or_embedded_and_placed() {
     for material in 0..3 {
         assert_eq!(
             world.texture_contents(material),
-            [Some(hash_bytes(&png())), None, None, None],
+            [Some(hash_bytes(&png())), None, None, None, None],
             "material {material}"
         );
     }
@@ -712,7 +774,7 @@ fn what_is_not_drawn_is_named_in_warnings() {
         r#""meshes": [{{"primitives": [{primitive}, {points}]}}], "nodes": [{{"mesh": 0}}, {{"camera": 0}}, {{"mesh": 0}}],
         "cameras": [{{"type": "orthographic", "orthographic": {{"xmag": 1, "ymag": 1, "znear": 0.1, "zfar": 9}}}}],
         "scenes": [{{"nodes": [0, 1, 2]}}, {{"name": "other", "nodes": []}}], "scene": 0,
-        "materials": [{{"name": "rough", "normalTexture": {{"index": 0}},
+        "materials": [{{"name": "rough", "occlusionTexture": {{"index": 0}},
             "emissiveFactor": [1, 1, 1], "emissiveTexture": {{"index": 0}}}}],
         "textures": [{{"source": 0}}], "images": [{{"uri": "n.png"}}],
         "extensionsUsed": ["KHR_materials_clearcoat", "KHR_lights_punctual"]"#
@@ -726,7 +788,7 @@ fn what_is_not_drawn_is_named_in_warnings() {
         "test.gltf: the file has 2 scenes; drawing scene 0",
         "test.gltf: camera 0 of node 1: orthographic camera not read (lumiere has no orthographic projection)",
         "test.gltf: material 'rough': not read: emissiveTexture (the material does not emit; --emission NAME=R,G,B \
-         makes it a light), normalTexture",
+         makes it a light), occlusionTexture",
         "test.gltf: mesh 0 primitive 1: Points are not drawn (lumiere draws triangles)",
     ];
     let mut warnings = scene.warnings.clone();

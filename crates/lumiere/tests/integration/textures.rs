@@ -668,10 +668,11 @@ fn the_scene_fingerprint_holds_how_a_mask_cuts() {
     }
 }
 
-/// The maps that paint a material's metallic weight and roughness are part of the scene's
-/// fingerprint: their files' bytes, the channel each reads, its factor and its placement.
+/// The maps that paint a material's metallic weight and roughness, and its normal map, are part
+/// of the scene's fingerprint: their files' bytes, the channel each reads, its factor and its
+/// placement.
 #[test]
-fn the_scene_fingerprint_holds_the_parameter_maps() {
+fn the_scene_fingerprint_holds_the_parameter_and_normal_maps() {
     use lumiere::textures::Channel;
     let dir = TempDir::new("fingerprint-parameter-maps");
     test_image().save_with_format(dir.path("orm.png"), ImageFormat::Png).unwrap();
@@ -685,6 +686,8 @@ fn the_scene_fingerprint_holds_the_parameter_maps() {
     };
     let plain = fingerprint(&|_| {});
     assert_eq!(fingerprint(&|_| {}), plain, "the same files, the same fingerprint");
+    let normal_map =
+        |scale| lumiere::materials::NormalMap { path: dir.path("orm.png"), transform: Default::default(), scale };
     let mut fingerprints = vec![
         plain,
         fingerprint(&|m| m.map_pr = None),
@@ -692,6 +695,8 @@ fn the_scene_fingerprint_holds_the_parameter_maps() {
         fingerprint(&|m| m.map_pr.as_mut().unwrap().channel = Channel::Blue),
         fingerprint(&|m| m.map_pr.as_mut().unwrap().scale = 0.5),
         fingerprint(&|m| m.map_pr.as_mut().unwrap().transform.offset.x = 0.5),
+        fingerprint(&|m| m.normal_map = Some(normal_map(1.0))),
+        fingerprint(&|m| m.normal_map = Some(normal_map(0.5))),
     ];
     let mut edited = test_image();
     edited.put_pixel(1, 1, Rgb([1, 2, 3]));

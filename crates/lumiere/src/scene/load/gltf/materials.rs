@@ -2,13 +2,13 @@
 //! extension's mapping (a metal from `metallic ≥ 0.5`, otherwise a plastic with a 4% layer;
 //! GGX `α = roughness²`), `KHR_materials_transmission` onto smooth glass of `KHR_materials_ior`'s
 //! index, emission from `emissiveFactor` (times `KHR_materials_emissive_strength`), and the base
-//! colour texture with its placement, the metallic-roughness texture as maps of the two, and
-//! `alphaMode` `MASK` and `BLEND` as cutouts by the base colour's alpha.
+//! colour texture with its placement, the metallic-roughness texture as maps of the two, the
+//! normal texture, and `alphaMode` `MASK` and `BLEND` as cutouts by the base colour's alpha.
 //! What is not honoured is named in one warning per material.
 //! docs/MATERIALS.md has the table.
 
 use crate::error::{shown_name, shown_path};
-use crate::materials::{CoverageTest, Cut, Material, ParameterMap};
+use crate::materials::{CoverageTest, Cut, Material, NormalMap, ParameterMap};
 use crate::math::UvTransform;
 use crate::scene::load::warnings::Warnings;
 use crate::textures::Channel;
@@ -72,13 +72,10 @@ pub(super) fn convert(
                 material.map_kd_transform = transform;
                 texcoord_set = set;
             }
-            Err(reason) => warnings.push(file, "base colour textures not read", || {
-                format!(
-                    "{}: material {}: baseColorTexture not read: {reason}; baseColorFactor is used instead",
-                    shown_path(file),
-                    shown_name(&name)
-                )
-            }),
+            Err(reason) => {
+                let not_read = TextureNotRead { kind: "base colour textures not read", texture: "baseColorTexture" };
+                not_read.warn(warnings, file, &name, &reason, "baseColorFactor is used instead")
+            }
         }
     }
     let glass = source.transmission().filter(|t| t.transmission_factor() >= GLASS_FROM_TRANSMISSION);
@@ -106,13 +103,21 @@ pub(super) fn convert(
             let base_set = material.map_kd.is_some().then_some(texcoord_set);
             match metallic_roughness_maps(&mut material, &info, base_set, image_path, &mut not_read) {
                 Ok(set) => texcoord_set = set,
-                Err(reason) => warnings.push(file, "metallic-roughness textures not read", || {
-                    format!(
-                        "{}: material {}: metallicRoughnessTexture not read: {reason}; metallicFactor and roughnessFactor are used instead",
-                        shown_path(file),
-                        shown_name(&name)
-                    )
-                }),
+                Err(reason) => {
+                    let texture = "metallicRoughnessTexture";
+                    let not_read = TextureNotRead { kind: "metallic-roughness textures not read", texture };
+                    not_read.warn(warnings, file, &name, &reason, "metallicFactor and roughnessFactor are used instead")
+                }
+            }
+        }
+    }
+    if let Some(normal) = source.normal_texture() {
+        let set_so_far = (material.map_kd.is_some() || material.map_pm.is_some()).then_some(texcoord_set);
+        match normal_map(&mut material, &normal, set_so_far, image_path, &mut not_read) {
+            Ok(set) => texcoord_set = set,
+            Err(reason) => {
+                let not_read = TextureNotRead { kind: "normal textures not read", texture: "normalTexture" };
+                not_read.warn(warnings, file, &name, &reason, "the surface keeps its interpolated normals")
             }
         }
     }
@@ -151,10 +156,7 @@ pub(super) fn convert(
             }
         }
     }
-    for (present, what) in [
-        (source.normal_texture().is_some(), "normalTexture"),
-        (source.occlusion_texture().is_some(), "occlusionTexture"),
-    ] {
+    for (present, what) in [(source.occlusion_texture().is_some(), "occlusionTexture")] {
         if present {
             not_read.push(what.to_string());
         }
@@ -166,6 +168,28 @@ pub(super) fn convert(
         });
     }
     Converted { material, texcoord_set, drawn }
+}
+
+/// A texture of a material that could not be read: the kind of warning (capped per kind) and the
+/// texture's glTF name.
+struct TextureNotRead {
+    kind: &'static str,
+    texture: &'static str,
+}
+
+impl TextureNotRead {
+    /// Warns (about `file`) that material `name`'s texture was not read, for `reason`, and what
+    /// is used `instead`.
+    fn warn(&self, warnings: &mut Warnings, file: &Path, name: &str, reason: &str, instead: &str) {
+        warnings.push(file, self.kind, || {
+            format!(
+                "{}: material {}: {} not read: {reason}; {instead}",
+                shown_path(file),
+                shown_name(name),
+                self.texture
+            )
+        })
+    }
 }
 
 /// glTF's `alphaCutoff` where a `MASK` material gives none.
@@ -202,8 +226,8 @@ fn warn_cut_whole(warnings: &mut Warnings, file: &Path, name: &str, why: &str) {
 
 /// glTF's `metallicRoughnessTexture` onto `material`'s metallic and roughness maps: its blue
 /// channel times `metallicFactor`, its green times `roughnessFactor` (data, not colours). Returns
-/// the coordinate set the material's textures read: the base colour's (`base_set`) where it has
-/// one, since a material's textures share one set here.
+/// the coordinate set the material's textures read ([`shared_set`], after the base colour's
+/// `base_set`).
 fn metallic_roughness_maps(
     material: &mut Material,
     info: &gltf::texture::Info,
@@ -220,14 +244,19 @@ fn metallic_roughness_maps(
     };
     material.map_pm = Some(map(Channel::Blue, material.metallic));
     material.map_pr = Some(map(Channel::Green, material.roughness));
-    match base_set {
-        Some(base_set) if base_set != set => {
-            not_read.push(format!(
-                "metallicRoughnessTexture's TEXCOORD_{set} (it reads TEXCOORD_{base_set}, as the base colour does)"
-            ));
-            Ok(base_set)
+    Ok(shared_set("metallicRoughnessTexture", set, base_set, not_read))
+}
+
+/// The coordinate set a material's textures read, where its texture `texture` names `set`: the
+/// set of its textures read before (`set_so_far`) where it has some, since a material's textures
+/// share one set here; a set that differs goes onto `not_read`.
+fn shared_set(texture: &str, set: u32, set_so_far: Option<u32>, not_read: &mut Vec<String>) -> u32 {
+    match set_so_far {
+        Some(so_far) if so_far != set => {
+            not_read.push(format!("{texture}'s TEXCOORD_{set} (it reads TEXCOORD_{so_far}, as the other textures do)"));
+            so_far
         }
-        _ => Ok(set),
+        _ => set,
     }
 }
 
@@ -238,14 +267,7 @@ fn texture_of(
     image_path: ImagePath,
     not_read: &mut Vec<String>,
 ) -> Result<(PathBuf, UvTransform, u32), String> {
-    let texture = info.texture();
-    let path = image_path(&texture.source())?;
-    let sampler = texture.sampler();
-    if sampler.wrap_s() != gltf::texture::WrappingMode::Repeat
-        || sampler.wrap_t() != gltf::texture::WrappingMode::Repeat
-    {
-        not_read.push("the sampler's wrapping (textures repeat)".to_string());
-    }
+    let path = texture_file(&info.texture(), image_path, not_read)?;
     let mut set = info.tex_coord();
     let mut transform = UvTransform::default();
     if let Some(placement) = info.texture_transform() {
@@ -261,6 +283,33 @@ fn texture_of(
         }
     }
     Ok((path, transform, set))
+}
+
+/// The file of `texture`'s image (or the name of its embedded bytes); a sampler that does not
+/// repeat goes onto `not_read`.
+fn texture_file(texture: &gltf::Texture, image_path: ImagePath, not_read: &mut Vec<String>) -> Result<PathBuf, String> {
+    let sampler = texture.sampler();
+    if sampler.wrap_s() != gltf::texture::WrappingMode::Repeat
+        || sampler.wrap_t() != gltf::texture::WrappingMode::Repeat
+    {
+        not_read.push("the sampler's wrapping (textures repeat)".to_string());
+    }
+    image_path(&texture.source())
+}
+
+/// glTF's `normalTexture` onto `material`'s normal map, with its `scale` (a `KHR_texture_transform`
+/// on it is not seen: the `gltf` crate reads that extension on other textures only). Returns the
+/// coordinate set the material's textures read ([`shared_set`], after `set_so_far`).
+fn normal_map(
+    material: &mut Material,
+    normal: &gltf::material::NormalTexture,
+    set_so_far: Option<u32>,
+    image_path: ImagePath,
+    not_read: &mut Vec<String>,
+) -> Result<u32, String> {
+    let path = texture_file(&normal.texture(), image_path, not_read)?;
+    material.normal_map = Some(NormalMap { path, transform: UvTransform::default(), scale: normal.scale() });
+    Ok(shared_set("normalTexture", normal.tex_coord(), set_so_far, not_read))
 }
 
 /// A placement `uv · scale + offset` in glTF's coordinates (`v` down from the image's top) as one in
