@@ -765,6 +765,26 @@ fn a_mesh_is_drawn_once_per_node_and_a_scene_instanced_past_memory_is_refused() 
     );
 }
 
+/// A hang: 20,000 nodes drawing a mesh of 20,000 primitives without vertices, a file of under
+/// 1 MB, took half a minute to load as empty, every primitive visited once per node.
+#[test]
+fn many_nodes_drawing_a_mesh_of_many_empty_primitives_load_at_once() {
+    const COUNT: usize = 20_000;
+    let mut builder = Builder::default();
+    let view = builder.view(&[0; 12], None);
+    let nothing = builder.accessor(Some(view), 0, FLOAT, 0, "VEC3", "");
+    let primitive = format!(r#"{{"attributes": {{"POSITION": {nothing}}}}}"#);
+    let rest = format!(
+        r#""meshes": [{{"primitives": [{}]}}], "nodes": [{}]"#,
+        vec![primitive.as_str(); COUNT].join(", "),
+        vec![r#"{"mesh": 0}"#; COUNT].join(", ")
+    );
+    let bytes = builder.gltf(&rest);
+    let start = std::time::Instant::now();
+    assert_eq!(parse(&bytes).mesh.triangle_count(), 0);
+    assert!(start.elapsed().as_secs_f64() < 5.0, "{:?} for {} bytes", start.elapsed(), bytes.len());
+}
+
 #[test]
 fn what_is_not_drawn_is_named_in_warnings() {
     let mut builder = Builder::default();

@@ -142,7 +142,9 @@ fn image_source(
 }
 
 /// What the whole scene will hold, counted from the accessors' declared counts before anything is
-/// read; warns about primitives that are not triangles.
+/// read; warns about primitives that are not triangles. Each mesh is measured once, then counted
+/// as many times as nodes draw it: a few bytes of nodes must not multiply the work by a mesh's
+/// primitives.
 fn counted(
     meshes: &[gltf::Mesh],
     instances: &[Instance],
@@ -150,48 +152,24 @@ fn counted(
     file: &Path,
     warnings: &mut Warnings,
 ) -> Result<MeshSize> {
-    let (mut positions, mut normals, mut texcoords, mut triangles) = (0u64, 0u64, 0u64, 0u64);
-    let mut warned = vec![false; meshes.len()];
+    let mut uses = vec![0u64; meshes.len()];
     for instance in instances {
-        let first_instance = !std::mem::replace(&mut warned[instance.mesh], true);
-        for primitive in meshes[instance.mesh].primitives() {
-            let where_ = || format!("{}: mesh {} primitive {}", shown_path(file), instance.mesh, primitive.index());
-            if !is_triangles(primitive.mode()) {
-                if !first_instance {
-                    continue;
-                }
-                warnings.push(file, "primitives not drawn", || {
-                    format!("{}: {:?} are not drawn (lumiere draws triangles)", where_(), primitive.mode())
-                });
-                continue;
-            }
-            if !primitives.draws(&primitive) {
-                continue;
-            }
-            let Some(position) = primitive.get(&Semantic::Positions) else {
-                return Err(Error::invalid(format!("{}: no POSITION attribute", where_())));
-            };
-            let vertices = position.count() as u64;
-            let set = primitives.sets[primitives.material(&primitive)];
-            for (semantic, total) in [(Semantic::Normals, &mut normals), (Semantic::TexCoords(set), &mut texcoords)] {
-                if let Some(attribute) = primitive.get(&semantic) {
-                    if attribute.count() != position.count() {
-                        return Err(Error::invalid(format!(
-                            "{}: {} has {} elements, POSITION {}",
-                            where_(),
-                            semantic.to_string(),
-                            attribute.count(),
-                            position.count()
-                        )));
-                    }
-                    *total = total.saturating_add(vertices);
-                }
-            }
-            positions = positions.saturating_add(vertices);
-            let corners = primitive.indices().map_or(vertices, |indices| indices.count() as u64);
-            triangles = triangles.saturating_add(triangle_count(primitive.mode(), corners));
+        uses[instance.mesh] += 1;
+    }
+    let mut totals = [0u64; 4];
+    // In the order nodes first draw the meshes, so that warnings and errors come in the walk's
+    // order; a mesh's uses are taken when it is measured.
+    for instance in instances {
+        let uses = std::mem::take(&mut uses[instance.mesh]);
+        if uses == 0 {
+            continue;
+        }
+        let size = measured_mesh(&meshes[instance.mesh], primitives, file, warnings)?;
+        for (total, count) in totals.iter_mut().zip(size) {
+            *total = total.saturating_add(count.saturating_mul(uses));
         }
     }
+    let [positions, normals, texcoords, triangles] = totals;
     // Corners index vertices with 32 bits: a scene of more vertices (instanced, it takes few bytes
     // to ask for) is refused here, whatever the memory.
     for (count, what) in [(positions, "vertices"), (normals, "normals"), (texcoords, "texture coordinates")] {
@@ -205,6 +183,47 @@ fn counted(
     }
     let clamp = |n: u64| usize::try_from(n).unwrap_or(usize::MAX);
     Ok(MeshSize { positions: clamp(positions), normals: clamp(normals), texcoords: clamp(texcoords), triangles })
+}
+
+/// The positions, normals, texture coordinates and triangles one drawing of `mesh` adds;
+/// warns about its primitives that are not triangles.
+fn measured_mesh(mesh: &gltf::Mesh, primitives: &Drawn, file: &Path, warnings: &mut Warnings) -> Result<[u64; 4]> {
+    let (mut positions, mut normals, mut texcoords, mut triangles) = (0u64, 0u64, 0u64, 0u64);
+    for primitive in mesh.primitives() {
+        let where_ = || format!("{}: mesh {} primitive {}", shown_path(file), mesh.index(), primitive.index());
+        if !is_triangles(primitive.mode()) {
+            warnings.push(file, "primitives not drawn", || {
+                format!("{}: {:?} are not drawn (lumiere draws triangles)", where_(), primitive.mode())
+            });
+            continue;
+        }
+        if !primitives.draws(&primitive) {
+            continue;
+        }
+        let Some(position) = primitive.get(&Semantic::Positions) else {
+            return Err(Error::invalid(format!("{}: no POSITION attribute", where_())));
+        };
+        let vertices = position.count() as u64;
+        let set = primitives.sets[primitives.material(&primitive)];
+        for (semantic, total) in [(Semantic::Normals, &mut normals), (Semantic::TexCoords(set), &mut texcoords)] {
+            if let Some(attribute) = primitive.get(&semantic) {
+                if attribute.count() != position.count() {
+                    return Err(Error::invalid(format!(
+                        "{}: {} has {} elements, POSITION {}",
+                        where_(),
+                        semantic.to_string(),
+                        attribute.count(),
+                        position.count()
+                    )));
+                }
+                *total = total.saturating_add(vertices);
+            }
+        }
+        positions = positions.saturating_add(vertices);
+        let corners = primitive.indices().map_or(vertices, |indices| indices.count() as u64);
+        triangles = triangles.saturating_add(triangle_count(primitive.mode(), corners));
+    }
+    Ok([positions, normals, texcoords, triangles])
 }
 
 fn is_triangles(mode: Mode) -> bool {
@@ -307,6 +326,11 @@ fn decode_mesh(mesh: &gltf::Mesh, buffers: BufferData, drawn: &Drawn, file: &Pat
             }
             None => (0..positions.len() as u32).collect(),
         };
+        // A primitive without vertices adds nothing (any index it has was refused above as out of
+        // range): left out, it costs no time however many nodes draw its mesh.
+        if positions.is_empty() {
+            continue;
+        }
         let triangles = assemble(primitive.mode(), &corners);
         primitives.push(Primitive { positions, normals, texcoords, triangles, material: material as u32 });
     }
