@@ -725,6 +725,52 @@ fn base_colour_textures_are_found_beside_the_file_or_embedded_and_placed() {
     }
 }
 
+/// The members of a file whose `i`-th material's base colour texture is an image in view
+/// `views[i]`, each on a quad of its own.
+fn textured_from_views(primitive: &str, views: &[usize]) -> String {
+    let materials: Vec<String> = (0..views.len())
+        .map(|i| format!(r#"{{"pbrMetallicRoughness": {{"baseColorTexture": {{"index": {i}}}}}}}"#))
+        .collect();
+    let textures: Vec<String> = (0..views.len()).map(|i| format!(r#"{{"source": {i}}}"#)).collect();
+    let images: Vec<String> =
+        views.iter().map(|v| format!(r#"{{"bufferView": {v}, "mimeType": "image/png"}}"#)).collect();
+    let images = format!(r#""images": [{}], "textures": [{}]"#, images.join(", "), textures.join(", "));
+    quad_per_material(primitive, &materials.iter().map(String::as_str).collect::<Vec<_>>(), &images)
+}
+
+/// Images in buffer views are copied out of the buffers once per view, and no more than the
+/// buffers hold in all: before, each image copied its view, so that a few dozen bytes of JSON per
+/// image or per view over the same bytes copied a large buffer as often as they liked.
+#[test]
+fn images_in_buffer_views_copy_no_more_than_the_buffers_hold() {
+    let mut builder = Builder::default();
+    let primitive = quad(&mut builder);
+    let view = builder.view(&png(), None);
+    // 50 images of one view share one copy of its bytes.
+    let scene = parse(&builder.gltf(&textured_from_views(&primitive, &[view; 50])));
+    let copies: Vec<*const u8> = scene
+        .materials
+        .iter()
+        .map(|m| scene.embedded_images.get(m.map_kd.as_ref().expect("a texture")).expect("embedded").as_ptr())
+        .collect();
+    assert!(copies.iter().all(|&copy| copy == copies[0]), "{} images, not one copy", copies.len());
+    // Views over the same bytes are copied each, up to the buffer's size; the textures past it are
+    // not read, with a warning each.
+    let fits = builder.blob.len() / png().len();
+    let same = builder.views[view].clone();
+    let views: Vec<usize> = (0..fits + 3)
+        .map(|_| {
+            builder.views.push(same.clone());
+            builder.views.len() - 1
+        })
+        .collect();
+    let scene = parse(&builder.gltf(&textured_from_views(&primitive, &views)));
+    let textured = scene.materials.iter().filter(|m| m.map_kd.is_some()).count();
+    assert_eq!(textured, fits, "{:?}", scene.warnings);
+    assert_eq!(scene.warnings.len(), 3, "{:?}", scene.warnings);
+    assert!(scene.warnings[0].starts_with(&format!("test.gltf: material 'material{fits}': baseColorTexture not read: the buffer views of the file's images overlap")), "{}", scene.warnings[0]);
+}
+
 #[test]
 fn a_mesh_is_drawn_once_per_node_and_a_scene_instanced_past_memory_is_refused() {
     let mut builder = Builder::default();

@@ -42,8 +42,10 @@ use gltf::accessor::Dimensions;
 use gltf::mesh::{Mode, Semantic};
 pub use materials::DEFAULT_NAME;
 use nodes::Instance;
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::rc::Rc;
+use std::sync::Arc;
 
 /// Loads `path` (`.gltf` or `.glb`, either also gzipped), reading the buffers it names beside it.
 pub fn load_gltf(path: &Path) -> Result<Scene> {
@@ -76,7 +78,8 @@ fn parse_within(bytes: &[u8], file: &Path, read: ReadFile, memory: Memory) -> Re
     let meshes: Vec<gltf::Mesh> = document.meshes().collect();
 
     let mut embedded = EmbeddedImages::default();
-    let mut image_path = |image: &gltf::Image| image_source(image, &buffers.data, file, &mut embedded);
+    let mut copies = ViewCopies::default();
+    let mut image_path = |image: &gltf::Image| image_source(image, &buffers.data, file, &mut embedded, &mut copies);
     // Every material the file defines is kept, drawn or not, at its index in the file, so that
     // `--emission NAME` finds any of them.
     let mut converted: Vec<materials::Converted> =
@@ -125,20 +128,50 @@ fn image_source(
     buffers: BufferData,
     file: &Path,
     embedded: &mut EmbeddedImages,
+    copies: &mut ViewCopies,
 ) -> Result<PathBuf, String> {
     let name = EmbeddedImages::name(file, image.index());
-    let bytes: Vec<u8> = match image.source() {
+    let bytes: Arc<[u8]> = match image.source() {
         gltf::image::Source::Uri { uri, .. } => match uri::resolve(uri, file)? {
             uri::Uri::File(path) => return Ok(path),
             // Materials sharing an image take it once.
             _ if embedded.contains(&name) => return Ok(name),
-            uri::Uri::Data(bytes) => bytes,
+            uri::Uri::Data(bytes) => bytes.into(),
         },
         gltf::image::Source::View { .. } if embedded.contains(&name) => return Ok(name),
-        gltf::image::Source::View { view, .. } => accessor::view_bytes(&view, buffers)?.to_vec(),
+        gltf::image::Source::View { view, .. } => copies.of(&view, buffers)?,
     };
-    embedded.add(name.clone(), bytes.into());
+    embedded.add(name.clone(), bytes);
     Ok(name)
+}
+
+/// The buffer views images are in, copied out of the buffers: each view once, however many images
+/// it holds, and all of them together at most the buffers' size. A few bytes of JSON per image, or
+/// per view over the same bytes, must not copy a large buffer again and again.
+#[derive(Default)]
+struct ViewCopies {
+    by_view: HashMap<usize, Arc<[u8]>>,
+    bytes: u64,
+}
+
+impl ViewCopies {
+    fn of(&mut self, view: &gltf::buffer::View, buffers: BufferData) -> Result<Arc<[u8]>, String> {
+        if let Some(copy) = self.by_view.get(&view.index()) {
+            return Ok(Arc::clone(copy));
+        }
+        let bytes = accessor::view_bytes(view, buffers)?;
+        let budget: u64 = buffers.iter().map(|buffer| buffer.len() as u64).sum();
+        let total = self.bytes + bytes.len() as u64;
+        if total > budget {
+            return Err(format!(
+                "the buffer views of the file's images overlap, holding more than the {budget} bytes of its buffers"
+            ));
+        }
+        self.bytes = total;
+        let copy: Arc<[u8]> = bytes.into();
+        self.by_view.insert(view.index(), Arc::clone(&copy));
+        Ok(copy)
+    }
 }
 
 /// What the whole scene will hold, counted from the accessors' declared counts before anything is
