@@ -101,6 +101,16 @@ fn a_scaled_parent_or_camera_node_changes_neither_the_directions_nor_the_view() 
 }
 
 #[test]
+fn a_camera_far_from_the_origin_keeps_its_line_of_sight_in_single_precision() {
+    // Turned 30° about +Y, it looks along (−1/2, 0, −√3/2), no axis: a target one unit away from
+    // an eye thousands of units out would be rounded off its line of sight in single precision.
+    let node = r#"{"camera": 0, "translation": [3000, -2000, 1000], "rotation": [0, 0.25881905, 0, 0.96592583]}"#;
+    let scene = load(&[PERSPECTIVE], &[node], "0, 1");
+    let forward = Vec3::new(-0.5, 0.0, -(3f32.sqrt()) / 2.0);
+    assert_view(the_view(&scene), Vec3::new(3000.0, -2000.0, 1000.0), forward, Vec3::Y, 0.8f32.to_degrees());
+}
+
+#[test]
 fn the_first_perspective_camera_of_the_walk_is_the_view_and_the_others_are_counted() {
     let far = r#"{"type": "perspective", "name": "Far", "perspective": {"yfov": 0.5, "znear": 0.1}}"#;
     // The walk goes 0, 3, 1, 2 (roots in the scene's order, a node before its children): node 3's

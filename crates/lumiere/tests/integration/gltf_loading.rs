@@ -682,6 +682,33 @@ fn blend_materials_stop_the_share_of_rays_their_alpha_covers() {
 }
 
 #[test]
+fn rough_glass_a_lone_ior_and_a_clamped_texture_axis_are_named_as_not_read() {
+    let mut builder = Builder::default();
+    let primitive = quad(&mut builder);
+    let materials = [
+        r#"{"name": "frosted", "pbrMetallicRoughness": {"roughnessFactor": 0.3},
+            "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1}}}"#,
+        r#"{"name": "diamond", "extensions": {"KHR_materials_ior": {"ior": 2.4}}}"#,
+        r#"{"name": "plain", "extensions": {"KHR_materials_ior": {"ior": 1.5}}}"#,
+        r#"{"name": "clamped", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}"#,
+    ];
+    // Only `t` is clamped (33071, CLAMP_TO_EDGE): one axis that does not repeat is enough.
+    let images = r#""images": [{"uri": "a.png"}], "textures": [{"source": 0, "sampler": 0}],
+        "samplers": [{"wrapT": 33071}], "extensionsUsed": ["KHR_materials_transmission", "KHR_materials_ior"]"#;
+    let scene = parse(&builder.gltf(&quad_per_material(&primitive, &materials, images)));
+    assert_eq!(
+        scene.warnings,
+        [
+            "test.gltf: material 'frosted': not read: roughness under transmission (the glass is smooth)",
+            "test.gltf: material 'diamond': not read: KHR_materials_ior without transmission (the specular layer \
+             reflects 4%)",
+            "test.gltf: material 'clamped': not read: the sampler's wrapping (textures repeat)",
+        ],
+        "glTF's own index of 1.5 alone changes nothing, so 'plain' has no warning"
+    );
+}
+
+#[test]
 fn base_colour_textures_are_found_beside_the_file_or_embedded_and_placed() {
     let dir = TempDir::new("gltf-textures");
     let mut builder = Builder::default();
