@@ -2,13 +2,16 @@
 //! in `data:` URIs), each under the name its materials use in place of a file's path, so that the
 //! rest of the renderer (decoding once, fingerprints, `info`) treats them as it treats files.
 
+use std::collections::BTreeMap;
 use std::fmt;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+/// Keyed by name: a file may embed tens of thousands of images, and a list searched for each
+/// would cost their square.
 #[derive(Clone, Default)]
 pub struct EmbeddedImages {
-    images: Vec<(PathBuf, Arc<[u8]>)>,
+    images: BTreeMap<PathBuf, Arc<[u8]>>,
 }
 
 impl EmbeddedImages {
@@ -22,18 +25,16 @@ impl EmbeddedImages {
 
     /// Adds `bytes` under `name`, unless an image goes by that name already.
     pub fn add(&mut self, name: PathBuf, bytes: Arc<[u8]>) {
-        if !self.contains(&name) {
-            self.images.push((name, bytes));
-        }
+        self.images.entry(name).or_insert(bytes);
     }
 
     /// The bytes of the image named `name`, if it is embedded.
     pub fn get(&self, name: &Path) -> Option<&[u8]> {
-        self.images.iter().find(|(n, _)| n == name).map(|(_, bytes)| &**bytes)
+        self.images.get(name).map(|bytes| &**bytes)
     }
 
     pub fn contains(&self, name: &Path) -> bool {
-        self.get(name).is_some()
+        self.images.contains_key(name)
     }
 
     pub fn is_empty(&self) -> bool {

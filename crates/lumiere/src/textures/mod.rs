@@ -35,6 +35,7 @@ mod embedded;
 pub use embedded::EmbeddedImages;
 
 use std::borrow::Cow;
+use std::collections::{HashMap, HashSet};
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -490,12 +491,9 @@ impl TextureSet {
         available: Option<u64>,
         embedded: &EmbeddedImages,
     ) -> (TextureSet, Vec<String>) {
-        let mut distinct: Vec<&Path> = Vec::new();
-        for path in paths {
-            if !distinct.contains(&path.as_ref()) {
-                distinct.push(path.as_ref());
-            }
-        }
+        // A set beside the list: a scene may name tens of thousands of textures.
+        let mut seen = HashSet::new();
+        let distinct: Vec<&Path> = paths.iter().map(AsRef::as_ref).filter(|path| seen.insert(*path)).collect();
         let mut left = available;
         let read: Vec<_> = distinct.iter().map(|path| read_within(path, embedded, &mut left)).collect();
         let decoded: Vec<Result<(Texture, u64), String>> = read
@@ -548,7 +546,9 @@ impl TextureSet {
         let paths: Vec<Option<&Path>> = paths.into_iter().collect();
         let distinct: Vec<&Path> = paths.iter().flatten().copied().collect();
         let (set, warnings) = TextureSet::load_or(&distinct, texture_use.instead(), embedded);
-        let ids = paths.iter().map(|path| path.and_then(|p| set.id_of(p))).collect();
+        let id_of: HashMap<&Path, TextureId> =
+            set.paths.iter().enumerate().map(|(i, path)| (path.as_path(), TextureId(i as u32))).collect();
+        let ids = paths.iter().map(|path| path.and_then(|p| id_of.get(p).copied())).collect();
         (ids, set, warnings)
     }
 
@@ -561,13 +561,12 @@ impl TextureSet {
         embedded: &EmbeddedImages,
     ) -> Vec<String> {
         let mut warnings = Vec::new();
-        let mut seen: Vec<(TextureUse, &Path)> = Vec::new();
+        let mut seen = HashSet::new();
         for (texture_use, path) in files {
             let Some(path) = path else { continue };
-            if seen.contains(&(texture_use, path)) || embedded.contains(path) {
+            if embedded.contains(path) || !seen.insert((texture_use, path)) {
                 continue;
             }
-            seen.push((texture_use, path));
             if let Err(reason) = check_file(path) {
                 warnings.push(unusable(path, &reason, texture_use.instead()));
             }
@@ -618,7 +617,7 @@ impl TextureSet {
 }
 
 /// What a texture is for, which decides what its material does without it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum TextureUse {
     /// The base colour (`map_Kd`, glTF's `baseColorTexture`).
     Diffuse,

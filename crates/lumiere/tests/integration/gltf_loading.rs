@@ -858,6 +858,34 @@ fn many_nodes_drawing_a_mesh_of_many_empty_primitives_load_at_once() {
     assert!(start.elapsed().as_secs_f64() < 5.0, "{:?} for {} bytes", start.elapsed(), bytes.len());
 }
 
+/// A file of tens of thousands of images, each in a `data:` URI and each its own material's base
+/// colour, loads at once: the embedded images and the textures are found by name, where lists
+/// searched for each took the square of their number (a minute for these 20,000).
+#[test]
+fn tens_of_thousands_of_embedded_images_load_at_once() {
+    const COUNT: usize = 20_000;
+    let mut builder = Builder::default();
+    let primitive = quad(&mut builder);
+    let data_uri = format!("data:image/png;base64,{}", base64::engine::general_purpose::STANDARD.encode(png()));
+    let material = |i| format!(r#"{{"pbrMetallicRoughness": {{"baseColorTexture": {{"index": {i}}}}}}}"#);
+    let rest = format!(
+        r#""materials": [{}], "textures": [{}], "images": [{}]"#,
+        (0..COUNT).map(material).collect::<Vec<_>>().join(", "),
+        (0..COUNT).map(|i| format!(r#"{{"source": {i}}}"#)).collect::<Vec<_>>().join(", "),
+        vec![format!(r#"{{"uri": "{data_uri}"}}"#); COUNT].join(", ")
+    );
+    let rest = format!("{}, {rest}", one_mesh(&primitive.replace(r#""indices""#, r#""material": 0, "indices""#)));
+    let bytes = builder.gltf(&rest);
+    let start = std::time::Instant::now();
+    let scene = parse(&bytes);
+    let materials: Vec<_> = scene.materials.iter().map(|m| m.map_kd.clone()).collect();
+    let paths = materials.iter().map(|path| path.as_deref());
+    let (ids, set, warnings) = lumiere::textures::TextureSet::for_materials(paths, &scene.embedded_images);
+    assert!(warnings.is_empty(), "{warnings:?}");
+    assert_eq!((ids.iter().flatten().count(), set.len()), (COUNT, COUNT));
+    assert!(start.elapsed().as_secs_f64() < 10.0, "{:?} for {} bytes", start.elapsed(), bytes.len());
+}
+
 #[test]
 fn what_is_not_drawn_is_named_in_warnings() {
     let mut builder = Builder::default();
