@@ -182,17 +182,19 @@ impl DiffuseLanes {
         let mut reaches = [false; PACKET];
         let mut above_ng = [false; PACKET];
         for lane in 0..PACKET {
-            let v = [0, 1, 2].map(|k| c[k] - self.p[k][lane]);
+            // Arrays written out, not `.map(..)`, whose call is not always inlined (see
+            // `direct.rs`): the loop must stay whole to be vectorised.
+            let v = [c[0] - self.p[0][lane], c[1] - self.p[1][lane], c[2] - self.p[2][lane]];
             let d2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
             let length = d2.sqrt();
-            let wi = v.map(|x| x / length);
+            let wi = [v[0] / length, v[1] / length, v[2] / length];
             let dot = |rows: &[[f32; PACKET]; 3]| rows[0][lane] * wi[0] + rows[1][lane] * wi[1] + rows[2][lane] * wi[2];
             let cos_surface = dot(&self.ns);
             let cos_light = n[0] * -wi[0] + n[1] * -wi[1] + n[2] * -wi[2];
             reaches[lane] = !(cos_surface <= 0.0 || cos_light <= 0.0 || dot(&self.ng) <= 0.0);
             weight[lane] = cos_surface * cos_light * light.area / d2;
             // `spawn_segment`'s side: the target above `ng` (almost always, once `wi` is).
-            let to_target = [0, 1, 2].map(|k| target[k] - self.p[k][lane]);
+            let to_target = [target[0] - self.p[0][lane], target[1] - self.p[1][lane], target[2] - self.p[2][lane]];
             above_ng[lane] =
                 self.ng[0][lane] * to_target[0] + self.ng[1][lane] * to_target[1] + self.ng[2][lane] * to_target[2]
                     >= 0.0;

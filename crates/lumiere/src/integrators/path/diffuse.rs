@@ -150,7 +150,9 @@ impl<const N: usize> DiffuseVertices<N> {
 
             // Next-event estimation: `LightSet::sample_li_on`, its pdf times the choice's.
             let b = sample_uniform_triangle(self.light_point[lane]);
-            let [t0, t1, t2] = light.targets.each_ref().map(|rows| row(rows, lane));
+            // Written out, not `.map(..)`, whose call is not always inlined (see `direct.rs`).
+            let [t0, t1, t2] =
+                [row(&light.targets[0], lane), row(&light.targets[1], lane), row(&light.targets[2], lane)];
             let target = b.x * t0 + b.y * t1 + b.z * t2;
             let v = target - surface.p;
             let dist2 = v.length_squared();
