@@ -371,7 +371,8 @@ fn asks_for_the_default(option: &[u8], values: &[&[u8]]) -> bool {
 /// number, with its values; the rest of the line, spaces included, is the file (Blender writes
 /// names with spaces unquoted). `-s` and `-o` place the texture (their u and v; w is for 3D
 /// textures); `-imfchan r|g|b|l` chooses a scalar map's channel; `-clamp off` is the default,
-/// repeat wrapping; the others are returned to be warned about. Backslashes become slashes, since files exported on Windows use them as separators.
+/// repeat wrapping; the others are returned to be warned about. Backslashes become slashes, since
+/// files exported on Windows use them as separators.
 fn texture_map(keyword: &str, mut tokens: Tokens, folder: &Path) -> Result<TextureMap, String> {
     let mut transform = UvTransform::default();
     let mut channel_read = Channel::Luminance;
@@ -388,12 +389,14 @@ fn texture_map(keyword: &str, mut tokens: Tokens, folder: &Path) -> Result<Textu
         let values = take_values(keyword, option, arity, &mut tokens)?;
         // The values of `-s` and `-o` are finite numbers (`take_values`).
         let number = |k: usize, default: f32| values.get(k).and_then(|v| finite_f32(v).ok()).unwrap_or(default);
-        let chosen = match (option, &values[..]) {
-            (b"-imfchan", [value]) if is_scalar_map(keyword) => channel(value),
-            _ => None,
-        };
+        if let (b"-imfchan", [value]) = (option, &values[..])
+            && is_scalar_map(keyword)
+            && let Some(chosen) = channel(value)
+        {
+            channel_read = chosen;
+            continue;
+        }
         match option {
-            _ if let Some(chosen) = chosen => channel_read = chosen,
             b"-s" => transform.scale = glam::Vec2::new(number(0, 1.0), number(1, 1.0)),
             b"-o" => transform.offset = glam::Vec2::new(number(0, 0.0), number(1, 0.0)),
             _ if asks_for_the_default(option, &values) => {}
