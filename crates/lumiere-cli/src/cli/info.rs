@@ -146,10 +146,11 @@ fn painted_scattering(material: &Material) -> Option<String> {
     } else {
         format!("alpha {}", number(material.pbr_alpha()))
     };
-    Some(match (&material.map_pm, material.metallic.is_some_and(|pm| pm >= 0.5)) {
+    // Without a metallic map, the constants' kind (`Material::kind`'s threshold) holds everywhere.
+    Some(match (&material.map_pm, material.kind()) {
         (Some(_), _) => format!("conductor where map_Pm reaches 0.5, plastic (Ks 0.04) elsewhere ({alpha})"),
-        (None, true) => format!("conductor (F0 the base colour, {alpha})"),
-        (None, false) => format!("plastic (Ks 0.04, {alpha})"),
+        (None, MaterialKind::Conductor { .. }) => format!("conductor (F0 the base colour, {alpha})"),
+        (None, _) => format!("plastic (Ks 0.04, {alpha})"),
     })
 }
 
