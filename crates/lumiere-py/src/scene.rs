@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use glam::{Vec2, Vec3};
 use lumiere::accel::BuildPreset;
-use lumiere::materials::Material;
+use lumiere::materials::{Material, Relief};
 use lumiere::math::UvTransform;
 use lumiere::render::fingerprint::scene_fingerprint;
 use lumiere::scene::Scene;
@@ -190,7 +190,15 @@ impl PyScene {
             for (key, map) in [("metallic_texture", &material.map_pm), ("roughness_texture", &material.map_pr)] {
                 entry.set_item(key, map.as_ref().map(|map| map.path.display().to_string()))?;
             }
-            entry.set_item("normal_texture", material.normal_map.as_ref().map(|map| map.path.display().to_string()))?;
+            // A bump map's file under its own key: its texels are heights, unless they have a
+            // normal map's colours (docs/MATERIALS.md).
+            let (normals, bumps) = match &material.normal_map {
+                Some(map) if map.relief == Relief::Directions => (Some(map), None),
+                map => (None, map.as_ref()),
+            };
+            for (key, map) in [("normal_texture", normals), ("bump_texture", bumps)] {
+                entry.set_item(key, map.map(|map| map.path.display().to_string()))?;
+            }
             entry.set_item("light", material.is_emissive())?;
             materials.set_item(&material.name, entry)?;
         }

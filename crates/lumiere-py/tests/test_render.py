@@ -251,7 +251,8 @@ def test_texture_placement_and_parameter_maps_show_in_info(tmp_path):
     obj.write_text("mtllib tiles.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
                    "usemtl tiles\nf 1/1 2/2 3/3\nusemtl plain\nf 1/1 2/2 3/3\n")
     (tmp_path / "tiles.mtl").write_text("newmtl tiles\nmap_Kd -s 4 2 1 -o 0.5 0 my tiles.png\nmap_d -o 0.25 mask.png\n"
-                                        "map_Pr -imfchan g orm.png\nnewmtl plain\nmap_Kd plain.png\n")
+                                        "map_Pr -imfchan g orm.png\nmap_Bump -bm 0.5 bumps.png\n"
+                                        "newmtl plain\nmap_Kd plain.png\nnorm normals.png\n")
     materials = lumiere.load(obj).info()["materials"]
     tiles, plain = materials["tiles"], materials["plain"]
     assert tiles["texture"] == str(tmp_path / "my tiles.png")
@@ -260,6 +261,8 @@ def test_texture_placement_and_parameter_maps_show_in_info(tmp_path):
     assert plain["texture_placement"] is None and plain["cutout_placement"] is None
     assert tiles["roughness_texture"] == str(tmp_path / "orm.png") and tiles["metallic_texture"] is None
     assert plain["roughness_texture"] is None
+    assert tiles["bump_texture"] == str(tmp_path / "bumps.png") and tiles["normal_texture"] is None
+    assert plain["normal_texture"] == str(tmp_path / "normals.png") and plain["bump_texture"] is None
 
 
 def test_texture_warnings_reach_python_as_the_cli_prints_them(cli, tmp_path):

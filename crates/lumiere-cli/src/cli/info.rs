@@ -10,7 +10,7 @@ use glam::Vec3;
 use lumiere::Result;
 use lumiere::error::quote;
 use lumiere::lights::LightSet;
-use lumiere::materials::{CoverageTest, Cut, Material, MaterialKind};
+use lumiere::materials::{CoverageTest, Cut, Material, MaterialKind, Relief};
 use lumiere::math::UvTransform;
 use lumiere::scene::Scene;
 use lumiere::scene::camera::View;
@@ -119,8 +119,15 @@ fn describe(material: &Material) -> String {
         }
     }
     if let Some(map) = &material.normal_map {
-        let path = map.path.display().to_string();
-        parts.push(format!("normal map {}{path:?} (scale {})", placement(map.transform), number(map.scale)));
+        let (path, at) = (map.path.display().to_string(), placement(map.transform));
+        parts.push(match map.relief {
+            Relief::Directions => format!("normal map {at}{path:?} (scale {})", number(map.scale)),
+            Relief::Heights { channel } => format!(
+                "bump map {at}{path:?} (heights: {} x {}; directions if the image has a normal map's colours)",
+                format!("{channel:?}").to_lowercase(),
+                number(map.scale)
+            ),
+        });
     }
     let test = material.map_d_test;
     if let Some(mask) = material.cutout_mask() {

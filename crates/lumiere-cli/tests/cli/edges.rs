@@ -639,12 +639,13 @@ fn info_names_materials_and_prints_no_negative_zero() {
         "kinds.mtl",
         "newmtl glass\nKd 0 0 0\nKs 1 1 1\nNi 1.5\nillum 7\nnewmtl mirror\nKd 0 0 0\nKs 1 1 1\nillum 3\n\
          newmtl brass\nKd 0.5 0.4 0.3\nPm 1\nPr 0.5\nnewmtl painted\nmap_Pm -imfchan b orm.png\nmap_Pr -imfchan g orm.png\n\
-         newmtl worn\nPm 1\nmap_Pr -s 2 2 worn.png\n",
+         newmtl worn\nPm 1\nmap_Pr -s 2 2 worn.png\nnewmtl bumpy\nmap_Bump -bm 0.5 bumps.png\n\
+         newmtl normals\nnorm normals.png\n",
     );
     let scene = dir.write(
         "kinds.obj",
         "mtllib kinds.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl glass\nf 1 2 3\nusemtl mirror\nf 1 2 3\nusemtl brass\nf 1 2 3\n\
-         usemtl painted\nf 1 2 3\nusemtl worn\nf 1 2 3\n",
+         usemtl painted\nf 1 2 3\nusemtl worn\nf 1 2 3\nusemtl bumpy\nf 1 2 3\nusemtl normals\nf 1 2 3\n",
     );
     let out = run(&["info", scene.to_str().unwrap()]);
     let text = String::from_utf8_lossy(&out.stdout);
@@ -668,16 +669,25 @@ fn info_names_materials_and_prints_no_negative_zero() {
     );
     assert!(text.contains("\"worn\": 1 triangles, conductor (F0 the base colour, alpha from map_Pr)"), "{text}");
     assert!(text.contains("map_Pr -s 2.000000 2.000000 -o 0.000000 0.000000 \""), "{text}");
+    let (bumps, normals) = (dir.path("bumps.png").display().to_string(), dir.path("normals.png").display().to_string());
+    assert!(
+        text.contains(&format!(
+            "\"bumpy\": 1 triangles, lambert, Kd (0.800000, 0.800000, 0.800000), bump map {bumps:?} (heights: \
+             luminance x 0.500000; directions if the image has a normal map's colours)\n"
+        )),
+        "{text}"
+    );
+    assert!(text.contains(&format!("normal map {normals:?} (scale 1.000000)\n")), "{text}");
     // The maps' files are missing: named once each, as a render would.
-    for file in ["orm.png", "worn.png"] {
+    for file in ["orm.png", "worn.png", "bumps.png", "normals.png"] {
         let warning = format!("{:?}: ", dir.path(file).display().to_string());
         assert_eq!(stderr(&out).matches(&warning).count(), 1, "{}", stderr(&out));
     }
-    assert!(
-        stderr(&out).contains("; the material's metallic and roughness values are used instead"),
-        "{}",
-        stderr(&out)
-    );
+    for instead in
+        ["the material's metallic and roughness values are used instead", "the surface keeps its interpolated normals"]
+    {
+        assert!(stderr(&out).contains(&format!("; {instead}")), "{}", stderr(&out));
+    }
     let dir = TempDir::new("info-unlit");
     let scene = dir.write("unlit.obj", "v 0 0 0\nv -1 0 0\nv 0 -1 0\nf 1 2 3\n");
     let out = run(&["info", scene.to_str().unwrap()]);

@@ -79,22 +79,39 @@ pub struct Material {
     /// `metallicRoughnessTexture`'s green channel): where it decodes, its value at the hit
     /// replaces `roughness`.
     pub map_pr: Option<ParameterMap>,
-    /// A tangent-space normal map (glTF's `normalTexture`) that bends the shading normal.
+    /// A texture that bends the shading normal: a tangent-space normal map (glTF's
+    /// `normalTexture`, MTL `norm`) or a height map (MTL `bump`, `map_Bump`).
     pub normal_map: Option<NormalMap>,
 }
 
-/// A tangent-space normal map: each texel's stored values `c` (data, not a colour), as `2c − 1`,
-/// are a direction in the frame of the surface's texture axes (`x` along increasing `u`, `y`
-/// along increasing `v`, glTF's and OpenGL's convention) and its shading normal (`z`), its `x`
-/// and `y` multiplied by `scale`.
+/// A texture that bends the shading normal, as its [`Relief`] says, `scale` times as strongly as
+/// drawn.
 #[derive(Clone, Debug, PartialEq)]
 pub struct NormalMap {
     /// The name of an image the scene file embeds, or a file's path.
     pub path: PathBuf,
     /// Where the texture lies on the surface.
     pub transform: UvTransform,
-    /// glTF's `normalTexture.scale`: how strongly the map bends the normal (1 as drawn).
+    /// How strongly the map bends the normal (1 as drawn): glTF's `normalTexture.scale`, MTL's
+    /// `-bm` (the bump multiplier).
     pub scale: f32,
+    pub relief: Relief,
+}
+
+/// How a [`NormalMap`]'s texels describe the relief of its surface.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Relief {
+    /// Directions: each texel's stored values `c` (data, not a colour), as `2c − 1`, are a
+    /// direction in the frame of the surface's texture axes (`x` along increasing `u`, `y` along
+    /// increasing `v`, glTF's and OpenGL's convention) and its shading normal (`z`), its `x` and
+    /// `y` multiplied by the map's scale (glTF's `normalTexture`, MTL `norm`).
+    Directions,
+    /// Heights: `channel` of the stored values is the surface's displacement along its normal,
+    /// in scene units times the map's scale, whose slopes tilt the normal (MTL `bump` and
+    /// `map_Bump`, pbrt's and Mitsuba's bump mapping). An image with the colours of a normal map
+    /// is read as [`Relief::Directions`] instead: Blender's exporter writes its normal maps as
+    /// `map_Bump` (`world/normals.rs` says how it is told apart).
+    Heights { channel: Channel },
 }
 
 /// A material parameter painted by a texture: one channel of the values its file stores (data,

@@ -27,7 +27,7 @@ pub use conductor::{Conductor, Mirror};
 pub use dielectric::Dielectric;
 pub use lambert::Lambert;
 pub use material::{
-    CoverageTest, Cut, DEFAULT_IOR, Material, MaterialKind, NormalMap, ParameterMap, SMOOTH_NS, alpha_from_ns,
+    CoverageTest, Cut, DEFAULT_IOR, Material, MaterialKind, NormalMap, ParameterMap, Relief, SMOOTH_NS, alpha_from_ns,
     pbr_alpha,
 };
 pub use plastic::Plastic;

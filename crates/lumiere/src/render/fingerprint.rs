@@ -5,7 +5,7 @@
 
 use std::hash::Hasher;
 
-use crate::materials::{CoverageTest, Cut};
+use crate::materials::{CoverageTest, Cut, Relief};
 use crate::render::checkpoint::{Checkpoint, differing_options};
 use crate::render::film::Film;
 use crate::render::{RenderOptions, RenderStats};
@@ -64,6 +64,11 @@ pub fn scene_fingerprint(world: &World) -> u64 {
             h.write(map.path.as_os_str().as_encoded_bytes());
             h.write_f32s([map.transform.scale, map.transform.offset].iter().flat_map(|v| v.to_array()));
             h.write_f32s([map.scale]);
+            // Directions add nothing: the fingerprints of scenes with normal maps stay what they were.
+            if let Relief::Heights { channel } = map.relief {
+                h.write(b"heights");
+                h.write_u8(channel as u8);
+            }
         }
         // The same for the textures' placements, hashed only where they move a texture.
         for (key, transform) in [(&b"map_kd -s -o"[..], m.map_kd_transform), (&b"map_d -s -o"[..], m.map_d_transform)] {

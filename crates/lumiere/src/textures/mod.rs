@@ -263,6 +263,12 @@ impl Texture {
         self.footprint(uv).iter().map(|&(i, w)| self.rgb.stored(i) * w).fold(Vec3::ZERO, |sum, value| sum + value)
     }
 
+    /// The values the file stores for every texel (not decoded from sRGB), in storage order: for
+    /// what a texture holds as a whole, such as whether it has a normal map's colours.
+    pub fn stored_texels(&self) -> impl Iterator<Item = Vec3> + '_ {
+        (0..self.width as usize * self.height as usize).map(|i| self.rgb.stored(i))
+    }
+
     /// The bilinearly filtered value of `channel` at `uv`, read from the values the file stores
     /// (not decoded from sRGB): a material parameter painted by the texture, such as a roughness.
     #[inline]
@@ -626,7 +632,7 @@ pub enum TextureUse {
     /// A material's metallic weight or roughness (`map_Pm`, `map_Pr`, glTF's
     /// `metallicRoughnessTexture`).
     Parameters,
-    /// A tangent-space normal map (glTF's `normalTexture`).
+    /// A normal or bump map (glTF's `normalTexture`, MTL `norm`, `bump`, `map_Bump`).
     Normals,
 }
 

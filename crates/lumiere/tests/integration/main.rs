@@ -23,6 +23,7 @@ mod path;
 mod ply_loading;
 mod quad_lights;
 mod range;
+mod relief_maps;
 mod sampling;
 mod seams;
 mod textures;

@@ -5,7 +5,7 @@ use crate::common::TempDir;
 use flate2::Compression;
 use flate2::write::GzEncoder;
 use glam::{Vec2, Vec3};
-use lumiere::materials::{MaterialKind, ParameterMap};
+use lumiere::materials::{MaterialKind, NormalMap, ParameterMap, Relief};
 use lumiere::math::UvTransform;
 use lumiere::scene::load::obj::{ObjScene, load_obj, parse_obj, parse_obj_with_chunk_size};
 use lumiere::scene::mesh::NO_INDEX;
@@ -463,17 +463,17 @@ fn mtl_statements_and_texture_paths() {
     let dir = TempDir::new("mtl-statements");
     std::fs::create_dir_all(dir.0.join("materials")).expect("mkdir");
     let mtl = "newmtl glass  # comment\n  Kd 0.1 0.2 0.3\n\tKs 0.5\nKe 1 2 3\nNs 50\nNi 1.5\nTr 0.25\nillum 7\n\
-               map_Kd -bm 1 -o 0 0 0 tex\\wood.png\nmap_Bump bump.png\nKa 1 1 1\nnewmtl ghostly\nd -halo 0.5\n";
+               map_Kd -bm 1 -o 0 0 0 tex\\wood.png\ndisp height.png\nKa 1 1 1\nnewmtl ghostly\nd -halo 0.5\n";
     dir.write("materials/glass.mtl", mtl.as_bytes());
     let obj = dir.write("scene.obj", format!("mtllib materials/glass.mtl\n{SQUARE}usemtl glass\nf 1 2 3\n").as_bytes());
     let scene = load_obj(&obj).expect("load");
-    // The bump map and the texture's options are not rendered: one warning names them; the
+    // The displacement map and the texture's options are not rendered: one warning names them; the
     // ambient `Ka` passes silently. "ghostly"'s `d 0.5` without `Ni` is not glass: coverage, which
     // only map_d gives.
     assert_eq!(scene.warnings.len(), 2, "{:?}", scene.warnings);
     assert!(
         scene.warnings[0]
-            .contains("material \"glass\" uses statements lumiere does not render: \"map_Kd -bm\", \"map_Bump\""),
+            .contains("material \"glass\" uses statements lumiere does not render: \"map_Kd -bm\", \"disp\""),
         "{:?}",
         scene.warnings
     );
@@ -550,6 +550,52 @@ fn metallic_and_roughness_maps_read_their_channel_and_placement() {
         scene.warnings,
         [
             "mem/t.mtl: material \"matte\" uses statements lumiere does not render: \"map_Pm -imfchan\" (see docs/MATERIALS.md)"
+        ]
+    );
+}
+
+/// `norm` is a normal map and `bump`, `map_Bump` and `map_bump` height maps (luminance, or the
+/// channel `-imfchan` chooses), each as strong as `-bm` says (1 without it) and placed by `-s` and
+/// `-o`; `norm` wins over a bump map before or after it, naming the bump map it leaves. `-bm` on
+/// another map is still named as not honoured, and `disp` too.
+#[test]
+fn normal_and_bump_maps_read_their_strength_channel_and_placement() {
+    let mtl = "newmtl bumpy\nmap_Bump -bm 0.25 -s 2 2 bricks bump.png\n\
+               newmtl short\nbump -imfchan r h.png\n\
+               newmtl lower\nmap_bump h.png\n\
+               newmtl normals\nnorm -bm 0.5 n.png\n\
+               newmtl both\nbump h.png\nnorm n.png\n\
+               newmtl both again\nnorm n.png\nmap_Bump h.png\n\
+               newmtl other\nmap_Kd -bm 2 k.png\ndisp d.png\n";
+    let scene = parse_with(&format!("mtllib t.mtl\n{SQUARE}usemtl bumpy\nf 1 2 3\n"), &[("t.mtl", mtl)]);
+    let [bumpy, short, lower, normals, both, both_again, other] = &scene.materials[..] else {
+        panic!("{:?}", scene.materials)
+    };
+    let map = |file: &str, scale: f32, tiles: f32, relief| NormalMap {
+        path: PathBuf::from(format!("mem/{file}")),
+        transform: UvTransform { scale: Vec2::splat(tiles), offset: Vec2::ZERO },
+        scale,
+        relief,
+    };
+    let heights = |channel| Relief::Heights { channel };
+    assert_eq!(bumpy.normal_map, Some(map("bricks bump.png", 0.25, 2.0, heights(Channel::Luminance))));
+    assert_eq!(short.normal_map, Some(map("h.png", 1.0, 1.0, heights(Channel::Red))));
+    assert_eq!(lower.normal_map, Some(map("h.png", 1.0, 1.0, heights(Channel::Luminance))));
+    assert_eq!(normals.normal_map, Some(map("n.png", 0.5, 1.0, Relief::Directions)));
+    assert_eq!(both.normal_map, Some(map("n.png", 1.0, 1.0, Relief::Directions)));
+    assert_eq!(both_again.normal_map, both.normal_map);
+    assert_eq!(other.normal_map, None);
+    let unrendered = |material: &str, what: &str| {
+        format!(
+            "mem/t.mtl: material \"{material}\" uses statements lumiere does not render: {what} (see docs/MATERIALS.md)"
+        )
+    };
+    assert_eq!(
+        scene.warnings,
+        [
+            unrendered("both", "\"bump\" (norm is used)"),
+            unrendered("both again", "\"map_Bump\" (norm is used)"),
+            unrendered("other", "\"map_Kd -bm\", \"disp\""),
         ]
     );
 }
@@ -663,11 +709,11 @@ fn numbers_in_the_forms_exporters_write() {
 /// costs the warning any statement there does, and the materials after it are read.
 #[test]
 fn an_unrendered_statement_before_the_first_newmtl_is_one_warning() {
-    let mtl = "map_Bump bumps.png\nnewmtl a\nKd 0 1 0\nmap_Bump bumps.png\n";
+    let mtl = "disp heights.png\nnewmtl a\nKd 0 1 0\ndisp heights.png\n";
     let scene = parse_with(&format!("mtllib m.mtl\n{SQUARE}usemtl a\nf 1 2 3\n"), &[("m.mtl", mtl)]);
     let expected = [
         "mem/m.mtl:1: statement before the first newmtl; line ignored",
-        "mem/m.mtl: material \"a\" uses statements lumiere does not render: \"map_Bump\" (see docs/MATERIALS.md)",
+        "mem/m.mtl: material \"a\" uses statements lumiere does not render: \"disp\" (see docs/MATERIALS.md)",
     ];
     assert_eq!(scene.warnings, expected);
     assert_eq!(material_of(&scene, 0).kd, Vec3::Y);

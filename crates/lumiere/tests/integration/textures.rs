@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use crate::common::TempDir;
 use glam::{Vec2, Vec3};
 use image::{ImageFormat, Rgb, RgbImage, Rgba, RgbaImage};
-use lumiere::materials::{CoverageTest, Cut};
+use lumiere::materials::{CoverageTest, Cut, Relief};
 use lumiere::render::fingerprint::scene_fingerprint;
 use lumiere::scene::Scene;
 use lumiere::textures::{EmbeddedImages, MAX_TEXELS, Texture, TextureSet, srgb_to_linear};
@@ -668,9 +668,9 @@ fn the_scene_fingerprint_holds_how_a_mask_cuts() {
     }
 }
 
-/// The maps that paint a material's metallic weight and roughness, and its normal map, are part
-/// of the scene's fingerprint: their files' bytes, the channel each reads, its factor and its
-/// placement.
+/// The maps that paint a material's metallic weight and roughness, and its normal or bump map,
+/// are part of the scene's fingerprint: their files' bytes, the channel each reads, its factor and
+/// its placement, and whether a map holds directions or heights.
 #[test]
 fn the_scene_fingerprint_holds_the_parameter_and_normal_maps() {
     use lumiere::textures::Channel;
@@ -686,8 +686,13 @@ fn the_scene_fingerprint_holds_the_parameter_and_normal_maps() {
     };
     let plain = fingerprint(&|_| {});
     assert_eq!(fingerprint(&|_| {}), plain, "the same files, the same fingerprint");
-    let normal_map =
-        |scale| lumiere::materials::NormalMap { path: dir.path("orm.png"), transform: Default::default(), scale };
+    let normal_map = |scale, relief| lumiere::materials::NormalMap {
+        path: dir.path("orm.png"),
+        transform: Default::default(),
+        scale,
+        relief,
+    };
+    let heights = |channel| Relief::Heights { channel };
     let mut fingerprints = vec![
         plain,
         fingerprint(&|m| m.map_pr = None),
@@ -695,8 +700,10 @@ fn the_scene_fingerprint_holds_the_parameter_and_normal_maps() {
         fingerprint(&|m| m.map_pr.as_mut().unwrap().channel = Channel::Blue),
         fingerprint(&|m| m.map_pr.as_mut().unwrap().scale = 0.5),
         fingerprint(&|m| m.map_pr.as_mut().unwrap().transform.offset.x = 0.5),
-        fingerprint(&|m| m.normal_map = Some(normal_map(1.0))),
-        fingerprint(&|m| m.normal_map = Some(normal_map(0.5))),
+        fingerprint(&|m| m.normal_map = Some(normal_map(1.0, Relief::Directions))),
+        fingerprint(&|m| m.normal_map = Some(normal_map(0.5, Relief::Directions))),
+        fingerprint(&|m| m.normal_map = Some(normal_map(1.0, heights(Channel::Luminance)))),
+        fingerprint(&|m| m.normal_map = Some(normal_map(1.0, heights(Channel::Red)))),
     ];
     let mut edited = test_image();
     edited.put_pixel(1, 1, Rgb([1, 2, 3]));

@@ -8,7 +8,7 @@
 //! docs/MATERIALS.md has the table.
 
 use crate::error::{shown_name, shown_path};
-use crate::materials::{CoverageTest, Cut, Material, NormalMap, ParameterMap};
+use crate::materials::{CoverageTest, Cut, Material, NormalMap, ParameterMap, Relief};
 use crate::math::UvTransform;
 use crate::scene::load::warnings::Warnings;
 use crate::textures::Channel;
@@ -308,7 +308,8 @@ fn normal_map(
     not_read: &mut Vec<String>,
 ) -> Result<u32, String> {
     let path = texture_file(&normal.texture(), image_path, not_read)?;
-    material.normal_map = Some(NormalMap { path, transform: UvTransform::default(), scale: normal.scale() });
+    material.normal_map =
+        Some(NormalMap { path, transform: UvTransform::default(), scale: normal.scale(), relief: Relief::Directions });
     Ok(shared_set("normalTexture", normal.tex_coord(), set_so_far, not_read))
 }
 

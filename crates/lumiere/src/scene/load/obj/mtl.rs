@@ -4,7 +4,7 @@
 use super::continued::{has_continuations, joined};
 use super::text::{LONE_CARRIAGE_RETURNS, Tokens, finite_f32, has_lone_carriage_returns, lines};
 use crate::error::{quote, shown_path};
-use crate::materials::{Material, MaterialKind, ParameterMap};
+use crate::materials::{Material, MaterialKind, NormalMap, ParameterMap, Relief};
 use crate::math::UvTransform;
 use crate::scene::load::path_from_bytes;
 use crate::scene::load::warnings::Warnings;
@@ -13,7 +13,7 @@ use glam::Vec3;
 use std::path::{Path, PathBuf};
 
 /// Parses the MTL file read from `path` into its materials, in file order, with one warning per
-/// line that was ignored (capped, see [`Warnings`]); `map_Kd` and `map_d` files resolve relative to its folder.
+/// line that was ignored (capped, see [`Warnings`]); texture files resolve relative to its folder.
 pub(super) fn parse_mtl(bytes: &[u8], path: &Path, warnings: &mut Warnings) -> Vec<Material> {
     let folder = path.parent().unwrap_or(Path::new(""));
     // Editors on Windows may start the file with a UTF-8 byte-order mark.
@@ -114,6 +114,9 @@ struct Notes {
     unsupported: Vec<String>,
     /// Whether a `d` statement set its coverage: a `Tr` then changes nothing, before or after it.
     has_d: bool,
+    /// The keyword of the statement that gave the material its normal map (`norm`, `bump`, ...):
+    /// `norm` wins over a bump map, before or after it.
+    relief_from: Option<&'static str>,
 }
 
 impl Notes {
@@ -165,6 +168,8 @@ enum Statement {
     Roughness(f32),
     MetallicMap(TextureMap),
     RoughnessMap(TextureMap),
+    /// `norm` (a normal map) or `bump`, `map_Bump`, `map_bump` (a height map), by its keyword.
+    ReliefMap(TextureMap, &'static str),
     /// A statement lumiere does not render (bump maps, specular maps, ...), by keyword.
     Unsupported(String),
 }
@@ -178,6 +183,7 @@ impl Statement {
             Statement::CoverageMap(map) => ("map_d", &map.options),
             Statement::MetallicMap(map) => ("map_Pm", &map.options),
             Statement::RoughnessMap(map) => ("map_Pr", &map.options),
+            Statement::ReliefMap(map, keyword) => (*keyword, &map.options),
             _ => return Vec::new(),
         };
         options.iter().map(|option| quote(format!("{keyword} {option}"))).collect()
@@ -204,6 +210,22 @@ impl Statement {
             Statement::Roughness(pr) => material.roughness = Some(pr),
             Statement::MetallicMap(map) => material.map_pm = Some(map.into_parameter()),
             Statement::RoughnessMap(map) => material.map_pr = Some(map.into_parameter()),
+            Statement::ReliefMap(map, keyword) => {
+                // `norm` wins over a bump map whatever their order, as `d` over `Tr`: the two
+                // describe one relief, and a normal map is the finer description of it.
+                let (kept, dropped) = match notes.relief_from {
+                    Some("norm") if keyword != "norm" => (None, Some(keyword)),
+                    Some(earlier) if keyword == "norm" && earlier != "norm" => (Some(map), Some(earlier)),
+                    _ => (Some(map), None),
+                };
+                if let Some(dropped) = dropped {
+                    notes.note_unsupported(format!("{} (norm is used)", quote(dropped)));
+                }
+                if let Some(map) = kept {
+                    material.normal_map = Some(map.into_relief(keyword));
+                    notes.relief_from = Some(keyword);
+                }
+            }
             Statement::Unsupported(keyword) => notes.note_unsupported(quote(&keyword)),
             Statement::NewMtl(_) | Statement::NamelessMtl | Statement::Transparency(_) => {}
         }
@@ -237,11 +259,20 @@ fn parse_statement(line: &[u8], folder: &Path) -> Result<Option<Statement>, Stri
         b"Pr" => Statement::Roughness(scalar(tokens)?),
         b"map_Pm" => Statement::MetallicMap(texture_map("map_Pm", tokens, folder)?),
         b"map_Pr" => Statement::RoughnessMap(texture_map("map_Pr", tokens, folder)?),
+        b"norm" => relief_map("norm", tokens, folder)?,
+        b"bump" => relief_map("bump", tokens, folder)?,
+        b"map_Bump" => relief_map("map_Bump", tokens, folder)?,
+        b"map_bump" => relief_map("map_bump", tokens, folder)?,
         // Comments, and ambient terms, which have no meaning in a physically based renderer.
         keyword if keyword.starts_with(b"#") || HARMLESS.contains(&keyword) => return Ok(None),
         keyword => Statement::Unsupported(String::from_utf8_lossy(keyword).into_owned()),
     };
     Ok(Some(statement))
+}
+
+/// A relief statement: `norm`, or one of the spellings of a bump map.
+fn relief_map(keyword: &'static str, tokens: Tokens, folder: &Path) -> Result<Statement, String> {
+    Ok(Statement::ReliefMap(texture_map(keyword, tokens, folder)?, keyword))
 }
 
 fn material_name(tokens: Tokens) -> Option<String> {
@@ -298,11 +329,13 @@ fn illumination<'a>(mut tokens: impl Iterator<Item = &'a [u8]>) -> Result<u32, S
 }
 
 /// A texture statement: the file, where it lies on the surface, the channel a scalar map reads
-/// (`-imfchan`), and the options written before it that lumiere ignores.
+/// (`-imfchan`), a relief map's strength (`-bm`), and the options written before it that lumiere
+/// ignores.
 struct TextureMap {
     path: PathBuf,
     transform: UvTransform,
     channel: Channel,
+    bump_multiplier: f32,
     options: Vec<String>,
 }
 
@@ -312,11 +345,23 @@ impl TextureMap {
     fn into_parameter(self) -> ParameterMap {
         ParameterMap { path: self.path, transform: self.transform, channel: self.channel, scale: 1.0 }
     }
+
+    /// The map as a material's normal map, given by statement `keyword`: `norm` gives directions,
+    /// the bump maps heights, both as strong as `-bm` says.
+    fn into_relief(self, keyword: &str) -> NormalMap {
+        let relief = if keyword == "norm" { Relief::Directions } else { Relief::Heights { channel: self.channel } };
+        NormalMap { path: self.path, transform: self.transform, scale: self.bump_multiplier, relief }
+    }
 }
 
 /// Whether texture statement `keyword` paints a scalar, whose channel `-imfchan` chooses.
 fn is_scalar_map(keyword: &str) -> bool {
-    matches!(keyword, "map_Pm" | "map_Pr")
+    matches!(keyword, "map_Pm" | "map_Pr") || is_bump_map(keyword)
+}
+
+/// Whether texture statement `keyword` is a height map.
+fn is_bump_map(keyword: &str) -> bool {
+    matches!(keyword, "bump" | "map_Bump" | "map_bump")
 }
 
 /// The channel `-imfchan VALUE` chooses, among those lumiere reads: `r`, `g`, `b`, or `l` (the
@@ -370,12 +415,14 @@ fn asks_for_the_default(option: &[u8], values: &[&[u8]]) -> bool {
 /// Parses `[options] file`: options come first, each a token that starts with `-` and is not a
 /// number, with its values; the rest of the line, spaces included, is the file (Blender writes
 /// names with spaces unquoted). `-s` and `-o` place the texture (their u and v; w is for 3D
-/// textures); `-imfchan r|g|b|l` chooses a scalar map's channel; `-clamp off` is the default,
+/// textures); `-imfchan r|g|b|l` chooses a scalar map's channel; `-bm` scales a relief map (`norm`
+/// and the bump maps); `-clamp off` is the default,
 /// repeat wrapping; the others are returned to be warned about. Backslashes become slashes, since
 /// files exported on Windows use them as separators.
 fn texture_map(keyword: &str, mut tokens: Tokens, folder: &Path) -> Result<TextureMap, String> {
     let mut transform = UvTransform::default();
     let mut channel_read = Channel::Luminance;
+    let mut bump_multiplier = 1.0;
     let mut options = Vec::new();
     loop {
         let mut ahead = tokens.clone();
@@ -397,6 +444,7 @@ fn texture_map(keyword: &str, mut tokens: Tokens, folder: &Path) -> Result<Textu
             continue;
         }
         match option {
+            b"-bm" if keyword == "norm" || is_bump_map(keyword) => bump_multiplier = number(0, 1.0),
             b"-s" => transform.scale = glam::Vec2::new(number(0, 1.0), number(1, 1.0)),
             b"-o" => transform.offset = glam::Vec2::new(number(0, 0.0), number(1, 0.0)),
             _ if asks_for_the_default(option, &values) => {}
@@ -408,7 +456,8 @@ fn texture_map(keyword: &str, mut tokens: Tokens, folder: &Path) -> Result<Textu
         return Err(format!("{keyword} without a file name"));
     }
     let file: Vec<u8> = file.iter().map(|&b| if b == b'\\' { b'/' } else { b }).collect();
-    Ok(TextureMap { path: folder.join(path_from_bytes(file)), transform, channel: channel_read, options })
+    let path = folder.join(path_from_bytes(file));
+    Ok(TextureMap { path, transform, channel: channel_read, bump_multiplier, options })
 }
 
 /// Takes the values of texture option `option` (with `arity`, from [`option_values`]) off
