@@ -50,6 +50,8 @@ impl NormalMaps {
     pub(super) fn for_materials(materials: &[Material], embedded: &EmbeddedImages) -> (NormalMaps, Vec<String>) {
         let paths = materials.iter().map(|m| m.normal_map.as_ref().map(|map| map.path.as_path()));
         let (ids, textures, warnings) = TextureSet::for_use(TextureUse::Normals, paths, embedded);
+        // Each texture's colours are looked at once, however many materials share it as a bump map.
+        let mut normal_coloured: Vec<Option<bool>> = vec![None; textures.len()];
         let of_material = materials
             .iter()
             .zip(ids)
@@ -58,8 +60,12 @@ impl NormalMaps {
                 let texture = id?;
                 let placement = Some(map.transform).filter(|p| !p.is_identity());
                 let relief = match map.relief {
-                    Relief::Heights { .. } if has_normal_map_colours(textures.get(texture)) => Relief::Directions,
-                    relief => relief,
+                    Relief::Heights { .. } => {
+                        let coloured = normal_coloured[texture.index()]
+                            .get_or_insert_with(|| has_normal_map_colours(textures.get(texture)));
+                        if *coloured { Relief::Directions } else { map.relief }
+                    }
+                    Relief::Directions => Relief::Directions,
                 };
                 Some(Placed { texture, placement, scale: map.scale, relief })
             })
