@@ -108,7 +108,10 @@ fn describe(material: &Material) -> String {
     if !matches!(kind, MaterialKind::Mirror { .. } | MaterialKind::Dielectric { .. }) {
         parts.push(format!("Kd {}", vector(material.kd)));
         if let Some(texture) = &material.map_kd {
-            parts.push(format!("map_Kd {}{:?}", placement(material.map_kd_transform), texture.display().to_string()));
+            let factor = material.map_kd_factor;
+            let tint = if factor == Vec3::ONE { String::new() } else { format!(" x {}", vector(factor)) };
+            let path = texture.display().to_string();
+            parts.push(format!("map_Kd {}{path:?}{tint}", placement(material.map_kd_transform)));
         }
     }
     for (keyword, map) in [("map_Pm", &material.map_pm), ("map_Pr", &material.map_pr)] {

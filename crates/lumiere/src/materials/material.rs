@@ -47,6 +47,9 @@ pub struct Material {
     pub map_kd: Option<PathBuf>,
     /// Where `map_kd` lies on the surface (its `-s` and `-o` options).
     pub map_kd_transform: UvTransform,
+    /// What `map_kd`'s colour is multiplied by: glTF's `baseColorFactor`; white for MTL, whose
+    /// `map_Kd` replaces `Kd`, as mainstream OBJ readers do.
+    pub map_kd_factor: Vec3,
     /// Coverage texture (MTL `map_d`), resolved relative to the MTL file: where its coverage fails
     /// `map_d_test` (below one half, for MTL) the surface is cut out (rays pass through it), as
     /// leaves and fences are drawn.
@@ -269,6 +272,7 @@ impl Material {
             map_kd: None,
             map_kd_transform: UvTransform::default(),
             map_d: None,
+            map_kd_factor: Vec3::ONE,
             map_d_transform: UvTransform::default(),
             map_d_test: CoverageTest::MTL,
             ni: 1.0,
@@ -291,6 +295,8 @@ impl Material {
     /// than arrives (below 0, take some away) in every lobe that reads it (diffuse, a metal's base
     /// colour). Returns what was clamped, for the loader's warning.
     pub fn clamp_kd(&mut self) -> Option<String> {
+        // A texture's factor (glTF's `baseColorFactor`, which is also its `kd`) likewise.
+        self.map_kd_factor = self.map_kd_factor.clamp(Vec3::ZERO, Vec3::ONE);
         let clamped = self.kd.clamp(Vec3::ZERO, Vec3::ONE);
         if clamped == self.kd {
             return None;

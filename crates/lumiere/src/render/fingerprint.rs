@@ -32,6 +32,11 @@ pub fn scene_fingerprint(world: &World) -> u64 {
         h.write_f32s([m.metallic, m.roughness].map(|v| v.unwrap_or(f32::NAN)));
         h.write_u32(m.illum);
         h.write(m.map_kd.as_deref().map_or(&b""[..], |p| p.as_os_str().as_encoded_bytes()));
+        // Only where it tints the texture, so that the fingerprints of MTL scenes stay.
+        if m.map_kd_factor != glam::Vec3::ONE {
+            h.write(b"map_kd factor");
+            h.write_f32s(m.map_kd_factor.to_array());
+        }
         // Only where present, so that the fingerprints of scenes without cutouts (and their
         // checkpoints) stay what they were before `map_d` was read.
         if let Some(map_d) = &m.map_d {

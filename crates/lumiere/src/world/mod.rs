@@ -31,9 +31,8 @@ pub struct World {
     lights: LightSet,
     /// Each material's kind, mapped once from its statements.
     kinds: Vec<MaterialKind>,
-    /// Each material's diffuse texture, decoded once, with its placement (`-s`, `-o`) where it
-    /// moves the texture: most scenes have none, and a lookup then costs what it did without.
-    texture_of_material: Vec<Option<(TextureId, Option<UvTransform>)>>,
+    /// Each material's diffuse texture, decoded once.
+    texture_of_material: Vec<Option<BaseColourMap>>,
     textures: TextureSet,
     /// The textures that paint materials' metallic weight and roughness, which make a PBR
     /// material's kind vary over its surface.
@@ -101,7 +100,7 @@ impl World {
         let kinds = scene.materials.iter().map(Material::kind).collect();
         let (texture_of_material, textures, mut warnings) =
             TextureSet::for_materials(scene.materials.iter().map(|m| m.map_kd.as_deref()), &scene.embedded_images);
-        let texture_of_material = placed(texture_of_material, scene.materials.iter().map(|m| m.map_kd_transform));
+        let texture_of_material = BaseColourMap::of_materials(texture_of_material, &scene.materials);
         let (parameters, parameter_warnings) =
             ParameterTextures::for_materials(&scene.materials, &scene.embedded_images);
         warnings.extend(parameter_warnings);
@@ -179,8 +178,8 @@ impl World {
     /// could not be used.
     pub fn texture_contents(&self, material: usize) -> [Option<u64>; 5] {
         let cutout = self.cutout_of_material[material].and_then(|cutout| cutout.texture);
-        let [diffuse, coverage] = [(self.texture_of_material[material], &self.textures), (cutout, &self.cutouts)]
-            .map(|(texture, set)| texture.map(|(id, _)| set.contents_hash(id)));
+        let diffuse = self.texture_of_material[material].map(|map| self.textures.contents_hash(map.texture));
+        let coverage = cutout.map(|(id, _)| self.cutouts.contents_hash(id));
         let [metallic, roughness] = self.parameters.contents(material);
         [diffuse, coverage, metallic, roughness, self.normal_maps.contents(material)]
     }
@@ -213,7 +212,10 @@ impl World {
     fn base_colour(&self, material: u32, uv: Vec2) -> Vec3 {
         let id = material as usize;
         match self.texture_of_material[id] {
-            Some((texture, placement)) => self.textures.sample(texture, placed_uv(placement, uv)),
+            Some(map) => {
+                let colour = self.textures.sample(map.texture, placed_uv(map.placement, uv));
+                map.factor.map_or(colour, |factor| colour * factor)
+            }
             None => self.scene.materials[id].kd,
         }
     }
@@ -252,8 +254,8 @@ impl World {
         if !self.prefetches {
             return;
         }
-        if let Some((texture, placement)) = self.texture_of_material[surface.material as usize] {
-            self.textures.prefetch(texture, placed_uv(placement, surface.uv));
+        if let Some(map) = self.texture_of_material[surface.material as usize] {
+            self.textures.prefetch(map.texture, placed_uv(map.placement, surface.uv));
         }
     }
 
@@ -535,6 +537,30 @@ fn placed(
 ) -> Vec<Option<(TextureId, Option<UvTransform>)>> {
     let moved = placements.map(|placement| Some(placement).filter(|p| !p.is_identity()));
     ids.into_iter().zip(moved).map(|(id, placement)| id.map(|id| (id, placement))).collect()
+}
+
+/// A material's diffuse texture, with its placement (`-s`, `-o`) and the factor its colour is
+/// multiplied by (glTF's `baseColorFactor`), each only where it changes what a lookup gives: most
+/// maps have neither, and a lookup then costs what it did without.
+#[derive(Clone, Copy)]
+struct BaseColourMap {
+    texture: TextureId,
+    placement: Option<UvTransform>,
+    factor: Option<Vec3>,
+}
+
+impl BaseColourMap {
+    /// The maps of `materials` whose textures decoded (`ids`, one per material).
+    fn of_materials(ids: Vec<Option<TextureId>>, materials: &[Material]) -> Vec<Option<BaseColourMap>> {
+        let map = |(id, material): (Option<TextureId>, &Material)| {
+            Some(BaseColourMap {
+                texture: id?,
+                placement: Some(material.map_kd_transform).filter(|p| !p.is_identity()),
+                factor: Some(material.map_kd_factor).filter(|&f| f != Vec3::ONE),
+            })
+        };
+        ids.into_iter().zip(materials).map(map).collect()
+    }
 }
 
 /// Where a texture placed by `placement` is read for the surface's `uv`.

@@ -709,6 +709,40 @@ fn rough_glass_a_lone_ior_and_a_clamped_texture_axis_are_named_as_not_read() {
     );
 }
 
+/// A base colour texture's colour is multiplied by `baseColorFactor`, as glTF says; the factor
+/// alone is the colour where the texture cannot be used.
+#[test]
+fn base_colour_factors_tint_their_textures() {
+    let mut builder = Builder::default();
+    let primitive = quad(&mut builder);
+    let texel = [200u8, 100, 50];
+    let image = builder.view(&encoded(image::RgbImage::from_raw(1, 1, texel.to_vec()).unwrap().into()), None);
+    let broken = builder.view(b"\x89PNG not an image", None);
+    let materials = [
+        r#"{"name": "tinted", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "baseColorFactor": [0.5, 1, 0.25, 1]}}"#,
+        r#"{"name": "white", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}"#,
+        r#"{"name": "broken", "pbrMetallicRoughness": {"baseColorTexture": {"index": 1}, "baseColorFactor": [0.5, 1, 0.25, 1]}}"#,
+    ];
+    let images = format!(
+        r#""images": [{{"bufferView": {image}, "mimeType": "image/png"}}, {{"bufferView": {broken}, "mimeType": "image/png"}}],
+        "textures": [{{"source": 0}}, {{"source": 1}}]"#
+    );
+    let scene = parse(&builder.gltf(&quad_per_material(&primitive, &materials, &images)));
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    let factor = Vec3::new(0.5, 1.0, 0.25);
+    assert_eq!([0, 1, 2].map(|m| scene.materials[m].map_kd_factor), [factor, Vec3::ONE, factor]);
+    let world = lumiere::world::World::new(scene, lumiere::accel::BuildPreset::Default);
+    assert_eq!(world.warnings().len(), 1, "{:?}", world.warnings());
+    let colour = Vec3::from(texel.map(|code| lumiere::textures::srgb_to_linear(f32::from(code) / 255.0)));
+    // glTF's default metallic weight, 1, makes each a metal whose F0 (its albedo) is the base colour.
+    for (m, expected) in [colour * factor, colour, factor].into_iter().enumerate() {
+        let ray = Ray::new(Vec3::new(2.0 * m as f32 + 0.5, 0.5, 1.0), -Vec3::Z);
+        let surface = world.surface(&ray, &world.intersect(&ray).unwrap());
+        let albedo = world.bsdf(&surface).albedo();
+        assert!((albedo - expected).abs().max_element() < 1e-6, "material {m}: {albedo} vs {expected}");
+    }
+}
+
 #[test]
 fn base_colour_textures_are_found_beside_the_file_or_embedded_and_placed() {
     let dir = TempDir::new("gltf-textures");

@@ -670,7 +670,8 @@ fn the_scene_fingerprint_holds_how_a_mask_cuts() {
 
 /// The maps that paint a material's metallic weight and roughness, and its normal or bump map,
 /// are part of the scene's fingerprint: their files' bytes, the channel each reads, its factor and
-/// its placement, and whether a map holds directions or heights.
+/// its placement, and whether a map holds directions or heights; so is a base colour texture's
+/// factor.
 #[test]
 fn the_scene_fingerprint_holds_the_parameter_and_normal_maps() {
     use lumiere::textures::Channel;
@@ -704,6 +705,7 @@ fn the_scene_fingerprint_holds_the_parameter_and_normal_maps() {
         fingerprint(&|m| m.normal_map = Some(normal_map(0.5, Relief::Directions))),
         fingerprint(&|m| m.normal_map = Some(normal_map(1.0, heights(Channel::Luminance)))),
         fingerprint(&|m| m.normal_map = Some(normal_map(1.0, heights(Channel::Red)))),
+        fingerprint(&|m| m.map_kd_factor = Vec3::new(0.5, 1.0, 1.0)),
     ];
     let mut edited = test_image();
     edited.put_pixel(1, 1, Rgb([1, 2, 3]));

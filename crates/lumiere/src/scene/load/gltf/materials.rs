@@ -65,9 +65,9 @@ pub(super) fn convert(
     if let Some(info) = pbr.base_color_texture() {
         match texture_of(&info, image_path, &mut not_read) {
             Ok((path, transform, set)) => {
-                if material.kd != Vec3::ONE {
-                    not_read.push("baseColorFactor under baseColorTexture (the texture is used alone)".to_string());
-                }
+                // The texture's colour times the factor, as glTF says (`kd`, the factor alone, is
+                // what the material shows where the texture cannot be used).
+                material.map_kd_factor = material.kd;
                 material.map_kd = Some(path);
                 material.map_kd_transform = transform;
                 texcoord_set = set;
