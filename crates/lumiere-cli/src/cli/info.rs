@@ -137,7 +137,11 @@ fn describe(material: &Material) -> String {
         let cut = if test == CoverageTest::MTL { "cutout".to_string() } else { cut(test, "its alpha") };
         parts.push(format!("map_d {}{:?} ({cut})", placement(material.map_d_transform), mask.display().to_string()));
     } else if !test.keeps_full_coverage() && !material.is_emissive() {
-        parts.push(cut(test, "coverage"));
+        // Without a texture the factor alone is the coverage (MTL's `d`, glTF's alpha).
+        parts.push(match test.cut {
+            Cut::Hashed => format!("covering {} of the surface, hashed", number(test.scale)),
+            Cut::Below(_) => cut(test, "coverage"),
+        });
     }
     if material.is_emissive() {
         parts.push(format!("Ke {} (a light)", vector(material.ke)));

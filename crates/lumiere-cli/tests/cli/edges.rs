@@ -640,12 +640,12 @@ fn info_names_materials_and_prints_no_negative_zero() {
         "newmtl glass\nKd 0 0 0\nKs 1 1 1\nNi 1.5\nillum 7\nnewmtl mirror\nKd 0 0 0\nKs 1 1 1\nillum 3\n\
          newmtl brass\nKd 0.5 0.4 0.3\nPm 1\nPr 0.5\nnewmtl painted\nmap_Pm -imfchan b orm.png\nmap_Pr -imfchan g orm.png\n\
          newmtl worn\nPm 1\nmap_Pr -s 2 2 worn.png\nnewmtl bumpy\nmap_Bump -bm 0.5 bumps.png\n\
-         newmtl normals\nnorm normals.png\n",
+         newmtl normals\nnorm normals.png\nnewmtl veil\nd 0.3\n",
     );
     let scene = dir.write(
         "kinds.obj",
         "mtllib kinds.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl glass\nf 1 2 3\nusemtl mirror\nf 1 2 3\nusemtl brass\nf 1 2 3\n\
-         usemtl painted\nf 1 2 3\nusemtl worn\nf 1 2 3\nusemtl bumpy\nf 1 2 3\nusemtl normals\nf 1 2 3\n",
+         usemtl painted\nf 1 2 3\nusemtl worn\nf 1 2 3\nusemtl bumpy\nf 1 2 3\nusemtl normals\nf 1 2 3\nusemtl veil\nf 1 2 3\n",
     );
     let out = run(&["info", scene.to_str().unwrap()]);
     let text = String::from_utf8_lossy(&out.stdout);
@@ -678,6 +678,8 @@ fn info_names_materials_and_prints_no_negative_zero() {
         "{text}"
     );
     assert!(text.contains(&format!("normal map {normals:?} (scale 1.000000)\n")), "{text}");
+    // `d` below 1 on a surface that is not glass: partial coverage.
+    assert!(text.contains("\"veil\": 1 triangles, lambert, Kd (0.800000, 0.800000, 0.800000), covering 0.300000 of the surface, hashed\n"), "{text}");
     // The maps' files are missing: named once each, as a render would.
     for file in ["orm.png", "worn.png", "bumps.png", "normals.png"] {
         let warning = format!("{:?}: ", dir.path(file).display().to_string());

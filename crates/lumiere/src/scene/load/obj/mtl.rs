@@ -4,7 +4,7 @@
 use super::continued::{has_continuations, joined};
 use super::text::{LONE_CARRIAGE_RETURNS, Tokens, finite_f32, has_lone_carriage_returns, lines};
 use crate::error::{quote, shown_path};
-use crate::materials::{Material, MaterialKind, NormalMap, ParameterMap, Relief};
+use crate::materials::{CoverageTest, Cut, Material, MaterialKind, NormalMap, ParameterMap, Relief};
 use crate::math::UvTransform;
 use crate::scene::load::path_from_bytes;
 use crate::scene::load::warnings::Warnings;
@@ -87,10 +87,22 @@ pub(super) fn parse_mtl(bytes: &[u8], path: &Path, warnings: &mut Warnings) -> V
         };
         warnings.push(path, "ignored MTL lines", || format!("{}:{}: {problem}; line ignored", shown_path(path), i + 1));
     }
-    let warn_unrendered = |(material, notes): (Material, Notes)| {
+    let finish = |(mut material, notes): (Material, Notes)| {
         let mut ignored = notes.unsupported;
         // Without `d`, a coverage below 1 can only have come from `Tr`.
-        ignored.extend(unrendered_values(&material, !notes.has_d));
+        let (below_one, zero) = if notes.has_d { ("\"d\" below 1", "\"d 0\"") } else { ("\"Tr\" above 0", "\"Tr 1\"") };
+        match partial_coverage(&mut material) {
+            Coverage::Whole | Coverage::Partial => {}
+            Coverage::None => warnings.push(path, "materials of no coverage", || {
+                format!(
+                    "{}: material {}: {zero} leaves none of its surface: it is not seen",
+                    shown_path(path),
+                    quote(&material.name)
+                )
+            }),
+            Coverage::LightKeptWhole => ignored.push(format!("{below_one} on an emitter (a light is whole)")),
+        }
+        ignored.extend(unrendered_values(&material));
         if !ignored.is_empty() {
             warnings.push(path, "unsupported MTL statements", || {
                 format!(
@@ -103,7 +115,7 @@ pub(super) fn parse_mtl(bytes: &[u8], path: &Path, warnings: &mut Warnings) -> V
         }
         material
     };
-    materials.into_iter().map(warn_unrendered).collect()
+    materials.into_iter().map(finish).collect()
 }
 
 /// What parsing learns of a material besides its values.
@@ -128,18 +140,43 @@ impl Notes {
     }
 }
 
+/// What a material's `d` (or `Tr`) makes of its surface.
+enum Coverage {
+    /// All of it is there: `d 1`, glass (whose `d` says it transmits), or a `map_d` cutout (whose
+    /// texture says where the surface is).
+    Whole,
+    /// The share `d` of it, hashed (docs/MATERIALS.md, "Cutouts").
+    Partial,
+    /// None of it (`d 0`).
+    None,
+    /// An emitter's, which stays whole whatever its `d`.
+    LightKeptWhole,
+}
+
+/// Reads a `d` below 1 on a surface that is neither glass nor cut out by `map_d` as partial
+/// coverage, as Blender reads it (an alpha): the share `d` of the surface is there, each point kept
+/// or cut by a hash of it, as glTF's `BLEND`, so that a veil of `d 0.3` stops 30% of the rays that
+/// meet it. A light stays whole (`Material::cutout_mask` says why).
+fn partial_coverage(material: &mut Material) -> Coverage {
+    let glass = matches!(material.kind(), MaterialKind::Dielectric { .. });
+    if glass || material.dissolve >= 1.0 || material.map_d.is_some() {
+        return Coverage::Whole;
+    }
+    if material.is_emissive() {
+        return Coverage::LightKeptWhole;
+    }
+    let share = material.dissolve.max(0.0);
+    material.map_d_test = CoverageTest { alpha_only: false, scale: share, cut: Cut::Hashed };
+    if share > 0.0 { Coverage::Partial } else { Coverage::None }
+}
+
 /// Statements lumiere reads but whose value, on this material, has no effect (docs/MATERIALS.md,
-/// "Not honoured"): a transmission filter on an opaque material, partial coverage without a
-/// texture (named as `Tr` if `coverage_from_tr`), an illumination model beyond 9.
-fn unrendered_values(material: &Material, coverage_from_tr: bool) -> Vec<String> {
+/// "Not honoured"): a transmission filter on an opaque material, an illumination model beyond 9.
+fn unrendered_values(material: &Material) -> Vec<String> {
     let glass = matches!(material.kind(), MaterialKind::Dielectric { .. });
     let mut notes = Vec::new();
     if !glass && material.tf != Vec3::ONE {
         notes.push("\"Tf\" (only glass filters light)".to_string());
-    }
-    if !glass && material.dissolve < 1.0 && material.map_d.is_none() {
-        let coverage = if coverage_from_tr { "\"Tr\" above 0" } else { "\"d\" below 1" };
-        notes.push(format!("{coverage} without \"Ni\" (partial coverage: use map_d for cutouts)"));
     }
     if material.illum > 9 {
         notes.push(quote(format!("illum {}", material.illum)));
