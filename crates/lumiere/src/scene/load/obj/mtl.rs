@@ -207,7 +207,7 @@ enum Statement {
     RoughnessMap(TextureMap),
     /// `norm` (a normal map) or `bump`, `map_Bump`, `map_bump` (a height map), by its keyword.
     ReliefMap(TextureMap, &'static str),
-    /// A statement lumiere does not render (bump maps, specular maps, ...), by keyword.
+    /// A statement lumiere does not render (displacement and specular maps, ...), by keyword.
     Unsupported(String),
 }
 
