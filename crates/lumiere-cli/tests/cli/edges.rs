@@ -276,7 +276,7 @@ fn the_statistics_and_the_checkpoint_replace_only_their_own_kind_of_file() {
 fn outputs_that_are_textures_or_masks_are_refused() {
     let dir = TempDir::new("clobber-textures");
     dir.write("m.mtl", "newmtl leaf\nmap_Kd colour.png\nmap_d mask.png\n");
-    let scene = dir.write("scene.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl leaf\nf 1 2 3\n");
+    let scene = dir.write("scene.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nusemtl leaf\nf 1/1 2/1 3/1\n");
     dir.write("colour.png", "not decoded before the refusal");
     dir.write("mask.png", "not decoded before the refusal");
     let scene = scene.to_str().unwrap();

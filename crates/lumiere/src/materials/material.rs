@@ -305,6 +305,16 @@ impl Material {
         Some(format!("colour {x} {y} {z} clamped to [0, 1] (a surface reflects at most the light it receives)"))
     }
 
+    /// Whether a texture paints some part of the material (its base colour, cutout, metallic
+    /// weight, roughness or relief): its triangles need texture coordinates.
+    pub fn reads_texture_coordinates(&self) -> bool {
+        self.map_kd.is_some()
+            || self.cutout_mask().is_some()
+            || self.map_pm.is_some()
+            || self.map_pr.is_some()
+            || self.normal_map.is_some()
+    }
+
     /// The coverage texture that cuts the surface out: `map_d`, except on an emitter. Lights are
     /// sampled over their whole triangles, so an emitter stays whole for the rays that find it
     /// too: cut out, a BSDF-sampled ray would pass where light sampling adds emission, and the two

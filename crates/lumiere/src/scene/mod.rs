@@ -5,6 +5,7 @@ pub mod builtin;
 pub mod camera;
 pub mod load;
 pub mod mesh;
+mod texcoords;
 
 use std::path::{Path, PathBuf};
 
@@ -107,6 +108,7 @@ impl Scene {
                 warnings.push(format!("{name}: material {}: {clamped}", shown_name(&material.name)));
             }
         }
+        warnings.extend(texcoords::warnings(&name, &mesh, &materials));
         Ok(Scene {
             name,
             mesh,

@@ -772,7 +772,7 @@ fn d_below_one_is_partial_coverage_where_the_surface_is_not_glass() {
             let name = ["veil", "glass", "leaf", "lamp", "gone", "solid"][k];
             let first = 4 * k + 1;
             format!(
-                "v {x} 0 0\nv {} 0 0\nv {} 1 0\nv {x} 1 0\nusemtl {name}\nf {first} {} {}\nf {first} {} {}\n",
+                "v {x} 0 0\nv {} 0 0\nv {} 1 0\nv {x} 1 0\nusemtl {name}\nf {first}/1 {}/1 {}/1\nf {first}/1 {}/1 {}/1\n",
                 x + 1.0,
                 x + 1.0,
                 first + 1,
@@ -782,7 +782,7 @@ fn d_below_one_is_partial_coverage_where_the_surface_is_not_glass() {
             )
         })
         .collect();
-    let obj = dir.write("s.obj", format!("mtllib m.mtl\n{quads}"));
+    let obj = dir.write("s.obj", format!("mtllib m.mtl\nvt 0.5 0.5\n{quads}"));
     let scene = lumiere::scene::Scene::load(&obj).unwrap();
     let hashed = |scale| CoverageTest { alpha_only: false, scale, cut: Cut::Hashed };
     let tests: Vec<CoverageTest> = scene.materials.iter().map(|m| m.map_d_test).collect();

@@ -717,3 +717,35 @@ fn the_scene_fingerprint_holds_the_parameter_and_normal_maps() {
         assert!(fingerprints[i + 1..].iter().all(|b| a != b), "{fingerprints:x?}");
     }
 }
+
+/// A textured material whose triangles lack texture coordinates reads its textures at
+/// `u = v = 0` there: the scene names the material and how many of its triangles, once; a
+/// material without textures, or one whose triangles all have coordinates, costs nothing.
+#[test]
+fn textured_triangles_without_texture_coordinates_are_named() {
+    let dir = TempDir::new("texcoords-missing");
+    dir.write(
+        "m.mtl",
+        "newmtl wood\nmap_Kd wood.png\nnewmtl rough\nmap_Pr r.png\nnewmtl bumpy\nbump b.png\nnewmtl plain\nKd 1 0 0\n\
+         newmtl tiles\nmap_Kd tiles.png\n",
+    );
+    let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n\
+               usemtl wood\nf 1/1 2/2 3/3\nf 1 2 3\nf 3 2 1\nusemtl rough\nf 1 2 3\nusemtl bumpy\nf 1 2 3\n\
+               usemtl plain\nf 1 2 3\nusemtl tiles\nf 1/1 2/2 3/3\n";
+    let scene = Scene::load(&dir.write("s.obj", obj)).unwrap();
+    let named = |material: &str, without: usize, total: usize, relief: &str| {
+        format!(
+            "{}: material '{material}': {without} of its {total} triangles have no texture coordinates: its \
+             textures are read at u = v = 0 there{relief}",
+            dir.path("s.obj").display()
+        )
+    };
+    let mut warnings: Vec<&String> = scene.warnings.iter().filter(|w| w.contains("texture coordinates")).collect();
+    warnings.sort();
+    let expected = [
+        named("bumpy", 1, 1, ", and its normal or bump map is not applied"),
+        named("rough", 1, 1, ""),
+        named("wood", 2, 3, ""),
+    ];
+    assert_eq!(warnings, expected.iter().collect::<Vec<_>>(), "{:#?}", scene.warnings);
+}
