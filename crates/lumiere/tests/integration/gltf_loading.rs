@@ -709,6 +709,26 @@ fn rough_glass_a_lone_ior_and_a_clamped_texture_axis_are_named_as_not_read() {
     );
 }
 
+/// A primitive without `TEXCOORD_0` under a textured material reads its texture at one point:
+/// the scene names the material and how many of its triangles, as for OBJ faces without `vt`.
+#[test]
+fn a_textured_primitive_without_texture_coordinates_is_named() {
+    let mut builder = Builder::default();
+    let positions = builder.floats(&[0., 0., 0., 1., 0., 0., 1., 1., 0., 0., 1., 0.], "VEC3");
+    let indices = builder.indices(&[0, 1, 2, 0, 2, 3]);
+    let primitive = format!(r#"{{"attributes": {{"POSITION": {positions}}}, "indices": {indices}}}"#);
+    let image = builder.view(&png(), None);
+    let materials = [r#"{"name": "painted", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}"#];
+    let images =
+        format!(r#""images": [{{"bufferView": {image}, "mimeType": "image/png"}}], "textures": [{{"source": 0}}]"#);
+    let scene = parse(&builder.gltf(&quad_per_material(&primitive, &materials, &images)));
+    assert_eq!(
+        scene.warnings,
+        ["test.gltf: material 'painted': 2 of its 2 triangles have no texture coordinates: its textures are \
+          read at u = v = 0 there"]
+    );
+}
+
 /// A base colour texture's colour is multiplied by `baseColorFactor`, as glTF says; the factor
 /// alone is the colour where the texture cannot be used.
 #[test]
