@@ -29,4 +29,10 @@ impl UvTransform {
     pub fn is_identity(self) -> bool {
         self == UvTransform::default()
     }
+
+    /// The placement where it moves the texture, `None` where it leaves it where it is (most
+    /// maps): lookups then skip the multiply and add.
+    pub fn moving(self) -> Option<UvTransform> {
+        Some(self).filter(|p| !p.is_identity())
+    }
 }

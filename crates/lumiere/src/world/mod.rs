@@ -535,8 +535,10 @@ fn placed(
     ids: Vec<Option<TextureId>>,
     placements: impl Iterator<Item = UvTransform>,
 ) -> Vec<Option<(TextureId, Option<UvTransform>)>> {
-    let moved = placements.map(|placement| Some(placement).filter(|p| !p.is_identity()));
-    ids.into_iter().zip(moved).map(|(id, placement)| id.map(|id| (id, placement))).collect()
+    ids.into_iter()
+        .zip(placements.map(UvTransform::moving))
+        .map(|(id, placement)| id.map(|id| (id, placement)))
+        .collect()
 }
 
 /// A material's diffuse texture, with its placement (`-s`, `-o`) and the factor its colour is
@@ -555,7 +557,7 @@ impl BaseColourMap {
         let map = |(id, material): (Option<TextureId>, &Material)| {
             Some(BaseColourMap {
                 texture: id?,
-                placement: Some(material.map_kd_transform).filter(|p| !p.is_identity()),
+                placement: material.map_kd_transform.moving(),
                 factor: Some(material.map_kd_factor).filter(|&f| f != Vec3::ONE),
             })
         };

@@ -58,7 +58,7 @@ impl NormalMaps {
             .map(|(material, id)| {
                 let map = material.normal_map.as_ref()?;
                 let texture = id?;
-                let placement = Some(map.transform).filter(|p| !p.is_identity());
+                let placement = map.transform.moving();
                 let relief = match map.relief {
                     Relief::Heights { .. } => {
                         let coloured = normal_coloured[texture.index()]

@@ -44,7 +44,7 @@ impl Parameter {
         match (map, id) {
             (Some(map), Some(texture)) => Parameter::Painted {
                 texture,
-                placement: Some(map.transform).filter(|p| !p.is_identity()),
+                placement: map.transform.moving(),
                 channel: map.channel,
                 scale: map.scale,
             },

@@ -90,12 +90,18 @@ pub(super) fn parse_mtl(bytes: &[u8], path: &Path, warnings: &mut Warnings) -> V
     let finish = |(mut material, notes): (Material, Notes)| {
         let mut ignored = notes.unsupported;
         // Without `d`, a coverage below 1 can only have come from `Tr`.
-        let (below_one, zero) = if notes.has_d { ("\"d\" below 1", "\"d 0\"") } else { ("\"Tr\" above 0", "\"Tr 1\"") };
+        let below_one = if notes.has_d { "\"d\" below 1" } else { "\"Tr\" above 0" };
         match partial_coverage(&mut material) {
             Coverage::Whole | Coverage::Partial => {}
             Coverage::None => warnings.push(path, "materials of no coverage", || {
+                // The statement as the file wrote it.
+                let none = if notes.has_d {
+                    format!("\"d {}\"", material.dissolve)
+                } else {
+                    format!("\"Tr {}\"", 1.0 - material.dissolve)
+                };
                 format!(
-                    "{}: material {}: {zero} leaves none of its surface: it is not seen",
+                    "{}: material {}: {none} leaves none of its surface: it is not seen",
                     shown_path(path),
                     quote(&material.name)
                 )
